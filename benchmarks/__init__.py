@@ -1,0 +1,1 @@
+"""Speed and accuracy benchmarks: ``python -m benchmarks [NAME ...]`` (or ``make bench``)."""

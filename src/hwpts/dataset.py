@@ -1,0 +1,147 @@
+"""The input/output dataset every layer speaks: the test bed records one, identification fits one.
+
+It lives outside both :mod:`hwpts.plant` and :mod:`hwpts.identification` so the identification
+library never imports the plant.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from hwpts.errors import DataError
+
+
+@dataclass(frozen=True)
+class IODataset:
+    """Sampled multi-input single-output data.
+
+    Attributes
+    ----------
+    time : ndarray, shape (n_samples,)
+        Sample instants [s], strictly increasing.
+    inputs : ndarray, shape (n_samples, n_inputs)
+        Input signals, one column per name in ``input_names``.
+    output : ndarray, shape (n_samples,)
+        The measured output signal.
+    input_names : tuple of str
+        Column names of the inputs (e.g. ``("valve_voltage_v", "pump_speed_rpm")``).
+    output_name : str
+        Name of the output (e.g. ``"motor_a_speed_rpm"``).
+    extra : dict of str -> ndarray
+        Other recorded columns (states, true spool position...), same length, not used for fitting.
+    """
+
+    time: np.ndarray
+    inputs: np.ndarray
+    output: np.ndarray
+    input_names: tuple[str, ...]
+    output_name: str
+    extra: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        time = np.asarray(self.time, dtype=float)
+        inputs = np.asarray(self.inputs, dtype=float)
+        output = np.asarray(self.output, dtype=float)
+        if inputs.ndim == 1:
+            inputs = inputs[:, None]
+        names = tuple(str(n) for n in self.input_names)
+        if time.ndim != 1 or output.ndim != 1 or inputs.ndim != 2:
+            raise DataError(
+                f"time and output must be 1-D and inputs 2-D; got shapes {time.shape}, "
+                f"{output.shape}, {inputs.shape}"
+            )
+        n = time.shape[0]
+        if output.shape[0] != n or inputs.shape[0] != n:
+            raise DataError(
+                f"time, inputs and output must have the same length; got {n}, "
+                f"{inputs.shape[0]}, {output.shape[0]}"
+            )
+        if len(names) != inputs.shape[1]:
+            raise DataError(f"{inputs.shape[1]} input columns but {len(names)} input names {names}")
+        for label, values in (("time", time), ("output", output), ("inputs", inputs)):
+            if not np.all(np.isfinite(values)):
+                bad = int(np.argwhere(~np.isfinite(values.reshape(n, -1)))[0, 0])
+                raise DataError(f"{label} has a non-finite value (NaN or inf) at row {bad}")
+        if n > 1 and not np.all(np.diff(time) > 0):
+            bad = int(np.argmax(~(np.diff(time) > 0))) + 1
+            raise DataError(f"time must be strictly increasing; it is not at row {bad}")
+        extra = {str(k): np.asarray(v, dtype=float) for k, v in dict(self.extra).items()}
+        for key, values in extra.items():
+            if values.shape != (n,):
+                raise DataError(f"extra column {key!r} has shape {values.shape}, expected ({n},)")
+        object.__setattr__(self, "time", time)
+        object.__setattr__(self, "inputs", inputs)
+        object.__setattr__(self, "output", output)
+        object.__setattr__(self, "input_names", names)
+        object.__setattr__(self, "output_name", str(self.output_name))
+        object.__setattr__(self, "extra", extra)
+
+    @property
+    def n_samples(self) -> int:
+        """Number of samples."""
+        return int(self.time.shape[0])
+
+    @property
+    def sample_time(self) -> float:
+        """Median sample period [s] (``nan`` for fewer than two samples)."""
+        if self.n_samples < 2:
+            return float("nan")
+        return float(np.median(np.diff(self.time)))
+
+    def input(self, name: str) -> np.ndarray:
+        """One input column by name."""
+        try:
+            return self.inputs[:, self.input_names.index(name)]
+        except ValueError:
+            raise DataError(f"no input named {name!r}; inputs are {list(self.input_names)}") from None
+
+    def slice(self, start: int | None = None, stop: int | None = None) -> IODataset:
+        """Rows ``start:stop`` as a new dataset."""
+        sl = slice(start, stop)
+        return IODataset(
+            self.time[sl],
+            self.inputs[sl],
+            self.output[sl],
+            self.input_names,
+            self.output_name,
+            {k: v[sl] for k, v in self.extra.items()},
+        )
+
+    def columns(self) -> dict[str, np.ndarray]:
+        """All columns by name: time_s, the inputs, the output, then the extra columns."""
+        cols = {"time_s": self.time}
+        for i, name in enumerate(self.input_names):
+            cols[name] = self.inputs[:, i]
+        cols[self.output_name] = self.output
+        cols.update(self.extra)
+        return cols
+
+    @classmethod
+    def from_columns(
+        cls,
+        columns: dict[str, np.ndarray],
+        input_names: Sequence[str],
+        output_name: str,
+        time_name: str | None = "time_s",
+        sample_time: float = 1.0,
+    ) -> IODataset:
+        """Build a dataset from named columns; a missing column raises :class:`DataError`.
+
+        Without a time column (``time_name=None`` or absent), time is ``arange(n) * sample_time``.
+        """
+        wanted = list(input_names) + [output_name]
+        missing = [c for c in wanted if c not in columns]
+        if missing:
+            raise DataError(
+                f"missing column(s) {missing}; available columns are {sorted(columns)}"
+            )
+        n = len(columns[output_name])
+        if time_name is not None and time_name in columns:
+            time = columns[time_name]
+        else:
+            time = np.arange(n) * float(sample_time)
+        inputs = np.column_stack([np.asarray(columns[c], dtype=float) for c in input_names])
+        return cls(time, inputs, columns[output_name], tuple(input_names), output_name)
