@@ -1,6 +1,127 @@
-"""``hwpts plant ...``: steady state, sweeps and simulations of the test bed."""
+"""``hwpts plant ...``: steady states, sweeps and simulations of the simulated test bed."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+from hwpts.commands._args import finite_float, grid, non_negative_float, non_negative_int, output_file
 
 
-def register(subparsers):
-    parser = subparsers.add_parser("plant", help="the simulated HWPTS test bed")
-    parser.set_defaults(handler=lambda args: parser.print_help())
+def register(subparsers) -> None:
+    """Add ``hwpts plant`` and its sub-commands."""
+    plant = subparsers.add_parser(
+        "plant", help="the simulated HWPTS test bed", description="The simulated hydraulic wind power transfer system."
+    )
+    sub = plant.add_subparsers(dest="plant_command", metavar="COMMAND", parser_class=type(plant))
+    sub.required = True
+
+    p = sub.add_parser(
+        "steady-state",
+        help="one steady operating point, as JSON",
+        description="Steady state at one valve command and pump speed. Prints one JSON object "
+        "(speeds in r/min, pressures in Pa).",
+    )
+    p.add_argument("--valve-voltage", type=finite_float, required=True, metavar="V", help="valve coil command [V]")
+    p.add_argument("--pump-speed", type=non_negative_float, required=True, metavar="RPM", help="pump speed [r/min]")
+    p.add_argument(
+        "--branch", choices=("none", "up", "down"), default="none",
+        help="none: averaged valve, no hysteresis; up/down: reached by increasing/decreasing voltage",
+    )
+    p.set_defaults(handler=steady_state_command)
+
+    p = sub.add_parser(
+        "sweep",
+        help="up and down steady-state sweeps to CSV",
+        description="Up and down steady-state sweeps of the valve command at every pump speed of a grid, "
+        "and their average. Columns: valve_voltage_v, pump_speed_rpm, direction (up|down|average), "
+        "motor_a_speed_rpm.",
+    )
+    p.add_argument("--out", type=output_file, required=True, metavar="FILE.csv", help="output CSV")
+    p.add_argument("--voltages", type=grid, default=(1.2, 3.8, 27), metavar="START:STOP:N",
+                   help="valve command grid [V] (default 1.2:3.8:27)")
+    p.add_argument("--pump-speeds", type=grid, default=(200.0, 1000.0, 81), metavar="START:STOP:N",
+                   help="pump speed grid [r/min] (default 200:1000:81)")
+    p.set_defaults(handler=sweep_command)
+
+    p = sub.add_parser(
+        "simulate",
+        help="simulate the test bed on a validation case or an inputs CSV",
+        description="Simulate the test bed (hysteresis, droop, sensor noise). Output columns: time_s, "
+        "valve_voltage_v, pump_speed_rpm (measured), motor_a_speed_rpm (measured), then the states.",
+    )
+    source = p.add_mutually_exclusive_group(required=True)
+    source.add_argument("--case", choices=("case1", "case2", "case3", "case4"), help="one of the paper's validation cases")
+    source.add_argument("--inputs", metavar="FILE.csv",
+                        help="CSV with columns time_s, valve_voltage_v [V], pump_speed_rpm [r/min, the command]")
+    p.add_argument("--out", type=output_file, required=True, metavar="FILE.csv", help="output CSV")
+    p.add_argument("--noise-std", type=non_negative_float, default=None, metavar="RPM",
+                   help="speed sensor noise standard deviation [r/min] (default: the test bed's 2.0)")
+    p.add_argument("--seed", type=non_negative_int, default=0, metavar="N", help="noise seed (default 0)")
+    p.set_defaults(handler=simulate_command)
+
+
+def steady_state_command(args) -> int:
+    from hwpts.plant import PlantParameters, steady_state
+
+    result = steady_state(PlantParameters.paper(), args.valve_voltage, args.pump_speed, branch=args.branch)
+    print(json.dumps({
+        "valve_voltage_v": args.valve_voltage,
+        "pump_speed_rpm": args.pump_speed,
+        "motor_a_speed_rpm": round(float(result.motor_a_speed_rpm), 4),
+        "motor_b_speed_rpm": round(float(result.motor_b_speed_rpm), 4),
+        "pump_pressure_pa": round(float(result.pump_pressure_pa), 2),
+        "motor_a_pressure_pa": round(float(result.motor_a_pressure_pa), 2),
+        "motor_b_pressure_pa": round(float(result.motor_b_pressure_pa), 2),
+    }, indent=2))
+    return 0
+
+
+def sweep_command(args) -> int:
+    from hwpts.io.datasets import write_csv
+    from hwpts.plant import PlantParameters, sweep
+
+    voltages = np.linspace(*args.voltages)
+    pumps = np.linspace(*args.pump_speeds)
+    result = sweep(PlantParameters.paper(), voltages, pumps)
+    vv, ww = np.meshgrid(voltages, pumps, indexing="ij")
+    n = vv.size
+    surfaces = (("up", result.up_rpm), ("down", result.down_rpm), ("average", result.average_rpm))
+    write_csv(args.out, {
+        "valve_voltage_v": np.tile(vv.ravel(), 3),
+        "pump_speed_rpm": np.tile(ww.ravel(), 3),
+        "direction": np.repeat([name for name, _ in surfaces], n),
+        "motor_a_speed_rpm": np.concatenate([s.ravel() for _, s in surfaces]),
+    })
+    print(
+        f"wrote {args.out}: {result.points_per_sweep} points per sweep (up, down, average); "
+        f"largest hysteresis gap {np.max(np.abs(result.gap_percent)):.1f} % of full scale"
+    )
+    return 0
+
+
+def simulate_command(args) -> int:
+    from hwpts.dataset import IODataset
+    from hwpts.errors import DataError
+    from hwpts.io.datasets import read_table, write_csv
+    from hwpts.plant import TestBed, validation_case
+    from hwpts.plant.testbed import DEFAULT_NOISE_STD_RPM
+
+    bed = TestBed(noise_std_rpm=DEFAULT_NOISE_STD_RPM if args.noise_std is None else args.noise_std)
+    if args.case:
+        dataset, _ = bed.record(validation_case(args.case), seed=args.seed)
+    else:
+        columns = read_table(args.inputs)
+        try:
+            inputs = IODataset.from_columns(columns, ["valve_voltage_v", "pump_speed_rpm"], "valve_voltage_v",
+                                            time_name="time_s")
+            if "time_s" not in columns:
+                raise DataError(f"missing column(s) ['time_s']; available columns are {sorted(columns)}")
+            dataset, _ = bed.run(inputs.time, inputs.input("valve_voltage_v"), inputs.input("pump_speed_rpm"),
+                                 seed=args.seed)
+        except DataError as error:
+            raise DataError(f"--inputs {args.inputs!r}: {error}") from None
+    write_csv(args.out, dataset.columns())
+    print(f"wrote {args.out}: {dataset.n_samples} samples, {dataset.time[-1] - dataset.time[0]:.2f} s")
+    return 0

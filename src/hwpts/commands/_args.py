@@ -1,0 +1,67 @@
+"""Argument types shared by the sub-commands: each rejects bad values with a message naming what
+was expected and what was received (argparse prefixes the argument's name)."""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+
+
+def finite_float(text: str) -> float:
+    """A finite real number."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
+    return value
+
+
+def non_negative_float(text: str) -> float:
+    """A finite real number >= 0."""
+    value = finite_float(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected a number >= 0, got {text!r}")
+    return value
+
+
+def non_negative_int(text: str) -> int:
+    """An integer >= 0."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, got {text!r}")
+    return value
+
+
+def grid(text: str) -> tuple[float, float, int]:
+    """START:STOP:N, an increasing grid of N >= 1 points (START == STOP only when N == 1)."""
+    parts = text.split(":")
+    if len(parts) != 3:
+        raise argparse.ArgumentTypeError(f"expected START:STOP:N, got {text!r}")
+    start, stop = finite_float(parts[0]), finite_float(parts[1])
+    try:
+        count = int(parts[2])
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number of points N in START:STOP:N, got {parts[2]!r}") from None
+    if count < 1:
+        raise argparse.ArgumentTypeError(f"empty grid: N must be >= 1, got {text!r}")
+    if stop < start:
+        raise argparse.ArgumentTypeError(f"reversed grid: STOP must be >= START, got {text!r}")
+    if count > 1 and stop == start:
+        raise argparse.ArgumentTypeError(f"{count} points need STOP > START, got {text!r}")
+    if count == 1 and stop != start:
+        raise argparse.ArgumentTypeError(f"one point needs START == STOP, got {text!r}")
+    return start, stop, count
+
+
+def output_file(text: str) -> Path:
+    """A path to write a file at (not an existing folder)."""
+    path = Path(text)
+    if path.is_dir():
+        raise argparse.ArgumentTypeError(f"expected a file path, got the folder {text!r}")
+    return path

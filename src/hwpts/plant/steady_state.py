@@ -1,0 +1,385 @@
+"""Steady states F(x, h, w_p) = 0 of the HWPTS, vectorised over many operating points.
+
+The static equations have a monotone structure that makes them solvable exactly and without
+initial guesses: for a given pump pressure P_p each motor branch has one shaft speed balancing its
+flow (the orifice flow falls and the motor's demand rises with speed), and the pump-line balance
+falls monotonically in P_p. So each point is a bracketed 1-D solve on P_p (Illinois regula falsi)
+around bracketed 1-D solves of the two branches. Newton on the full 5-state system cycles across
+the check-valve kink near the fracture line; this cannot. Compiled with numba; the points are independent,
+so a sweep is a map over chunks of points (PLANT.md section 7).
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+
+from hwpts.errors import ParameterError, SimulationError
+from hwpts.plant.dynamics import N_STATES, pump_speed_actual
+from hwpts.plant.parameters import PARAMETER_INDEX as _I
+from hwpts.plant.parameters import PlantParameters
+from hwpts.plant.valve import MAKEUP_SMOOTHING_PA, orifice_shape, play_operator, smooth_max0, spool_position
+from hwpts.units import RAD_S_PER_RPM, RPM_PER_RAD_S
+
+BRANCHES = ("none", "up", "down")
+
+# parameter positions in PlantParameters.as_array() (compile-time constants for numba)
+_AUX_OPENING_PRESSURE = _I["aux_opening_pressure"]
+_COULOMB_SPEED_WIDTH = _I["coulomb_speed_width"]
+_DISCHARGE_COEFFICIENT = _I["discharge_coefficient"]
+_DROOP_GAIN = _I["droop_gain"]
+_LEAK_AREA = _I["leak_area"]
+_MAKEUP_GAIN = _I["makeup_gain"]
+_MAX_ORIFICE_AREA = _I["max_orifice_area"]
+_MOTOR_A_DAMPING = _I["motor_a_damping"]
+_MOTOR_A_DISPLACEMENT = _I["motor_a_displacement"]
+_MOTOR_A_LEAKAGE = _I["motor_a_leakage"]
+_MOTOR_A_LOAD_TORQUE = _I["motor_a_load_torque"]
+_MOTOR_B_DAMPING = _I["motor_b_damping"]
+_MOTOR_B_DISPLACEMENT = _I["motor_b_displacement"]
+_MOTOR_B_LEAKAGE = _I["motor_b_leakage"]
+_MOTOR_B_LOAD_TORQUE = _I["motor_b_load_torque"]
+_OIL_DENSITY = _I["oil_density"]
+_ORIFICE_TRANSITION_PRESSURE = _I["orifice_transition_pressure"]
+_PUMP_DISPLACEMENT = _I["pump_displacement"]
+_PUMP_LEAKAGE = _I["pump_leakage"]
+_RELIEF_GAIN = _I["relief_gain"]
+_RELIEF_PRESSURE = _I["relief_pressure"]
+_SMOOTHING_PRESSURE = _I["smoothing_pressure"]
+_SPOOL_STROKE = _I["spool_stroke"]
+
+_FLOW_SCALE = 1e-4  # m^3/s, typical flow: the reported residual is divided by it
+
+
+@numba.njit(cache=True)
+def solve_linear_inplace(a, b):
+    """Solve a x = b by Gaussian elimination with partial pivoting; b is overwritten by x.
+
+    Returns False when the matrix is singular. Small dense systems (5 x 5, 6 x 6) only.
+    """
+    n = b.shape[0]
+    for k in range(n):
+        piv = k
+        big = abs(a[k, k])
+        for i in range(k + 1, n):
+            if abs(a[i, k]) > big:
+                big = abs(a[i, k])
+                piv = i
+        if big == 0.0 or not math.isfinite(big):
+            return False
+        if piv != k:
+            for j in range(n):
+                tmp = a[k, j]
+                a[k, j] = a[piv, j]
+                a[piv, j] = tmp
+            tmp = b[k]
+            b[k] = b[piv]
+            b[piv] = tmp
+        for i in range(k + 1, n):
+            f = a[i, k] / a[k, k]
+            if f != 0.0:
+                for j in range(k, n):
+                    a[i, j] -= f * a[k, j]
+                b[i] -= f * b[k]
+    for i in range(n - 1, -1, -1):
+        s = b[i]
+        for j in range(i + 1, n):
+            s -= a[i, j] * b[j]
+        b[i] = s / a[i, i]
+    return True
+
+
+@numba.njit(cache=True)
+def _branch_residual(w, pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu, eps_mu):
+    """Flow balance of one motor branch at shaft speed w, supply pressure pp (decreasing in w)."""
+    pm = (damping * w + torque * math.tanh(w / ws)) / dm
+    q = c * area * orifice_shape(pp - pm - opening, pcr, eps)
+    return q + kmu * smooth_max0(-pm, eps_mu) - dm * w - cs * pm
+
+
+@numba.njit(cache=True)
+def _branch_speed(pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu, eps_mu):
+    """The unique shaft speed balancing a motor branch (Illinois regula falsi on a bracket)."""
+    lo = -1.0
+    f_lo = _branch_residual(lo, pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu, eps_mu)
+    hi = max(pp, 1.0) * dm / damping + 10.0
+    f_hi = _branch_residual(hi, pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu, eps_mu)
+    if f_lo <= 0.0:
+        return lo
+    side = 0
+    for _ in range(200):
+        w = (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
+        if not (lo < w < hi):
+            w = 0.5 * (lo + hi)
+        f = _branch_residual(w, pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu, eps_mu)
+        if f > 0.0:
+            lo = w
+            f_lo = f
+            if side == 1:
+                f_hi *= 0.5
+            side = 1
+        else:
+            hi = w
+            f_hi = f
+            if side == -1:
+                f_lo *= 0.5
+            side = -1
+        if hi - lo <= 1e-12 * (1.0 + abs(w)):
+            break
+    return 0.5 * (lo + hi)
+
+
+@numba.njit(cache=True)
+def _pump_balance(pp, h, wp_cmd, p, speeds):
+    """Pump-line flow balance at pump pressure pp (decreasing in pp); writes the shaft speeds."""
+    c = p[_DISCHARGE_COEFFICIENT] * math.sqrt(2.0 / p[_OIL_DENSITY])
+    frac = h / p[_SPOOL_STROKE]
+    area_a = p[_MAX_ORIFICE_AREA] * (1.0 - frac) + p[_LEAK_AREA]
+    area_b = p[_MAX_ORIFICE_AREA] * frac + p[_LEAK_AREA]
+    eps = p[_SMOOTHING_PRESSURE]
+    pcr = p[_ORIFICE_TRANSITION_PRESSURE]
+    kmu = p[_MAKEUP_GAIN]
+    wa = _branch_speed(pp, area_a, 0.0, p[_MOTOR_A_DISPLACEMENT], p[_MOTOR_A_LEAKAGE], p[_MOTOR_A_DAMPING],
+                       p[_MOTOR_A_LOAD_TORQUE], p[_COULOMB_SPEED_WIDTH], c, pcr, eps, kmu, MAKEUP_SMOOTHING_PA)
+    wb = _branch_speed(pp, area_b, p[_AUX_OPENING_PRESSURE], p[_MOTOR_B_DISPLACEMENT], p[_MOTOR_B_LEAKAGE],
+                       p[_MOTOR_B_DAMPING], p[_MOTOR_B_LOAD_TORQUE], p[_COULOMB_SPEED_WIDTH], c, pcr, eps,
+                       kmu, MAKEUP_SMOOTHING_PA)
+    speeds[0] = wa
+    speeds[1] = wb
+    pa = (p[_MOTOR_A_DAMPING] * wa + p[_MOTOR_A_LOAD_TORQUE] * math.tanh(wa / p[_COULOMB_SPEED_WIDTH])) / p[_MOTOR_A_DISPLACEMENT]
+    pb = (p[_MOTOR_B_DAMPING] * wb + p[_MOTOR_B_LOAD_TORQUE] * math.tanh(wb / p[_COULOMB_SPEED_WIDTH])) / p[_MOTOR_B_DISPLACEMENT]
+    qa = c * area_a * orifice_shape(pp - pa, pcr, eps)
+    qb = c * area_b * orifice_shape(pp - pb - p[_AUX_OPENING_PRESSURE], pcr, eps)
+    wp = wp_cmd - p[_DROOP_GAIN] * p[_PUMP_DISPLACEMENT] * pp
+    qp = p[_PUMP_DISPLACEMENT] * wp - p[_PUMP_LEAKAGE] * pp
+    qrv = p[_RELIEF_GAIN] * smooth_max0(pp - p[_RELIEF_PRESSURE], eps)
+    return qp + kmu * smooth_max0(-pp, MAKEUP_SMOOTHING_PA) - qa - qb - qrv
+
+
+@numba.njit(cache=True)
+def _solve_points(spool, wp_cmd, p, out, iterations, residual, tol, max_iter):
+    """Steady state of each point: outer bracketed solve on P_p, inner on each shaft speed."""
+    n = spool.shape[0]
+    speeds = np.empty(2)
+    for k in range(n):
+        h = spool[k]
+        w = wp_cmd[k]
+        lo = 0.0
+        f_lo = _pump_balance(lo, h, w, p, speeds)
+        hi = p[_RELIEF_PRESSURE]
+        f_hi = _pump_balance(hi, h, w, p, speeds)
+        grow = 0
+        while f_hi > 0.0 and grow < 60:
+            lo = hi
+            f_lo = f_hi
+            hi *= 2.0
+            f_hi = _pump_balance(hi, h, w, p, speeds)
+            grow += 1
+        it = 0
+        side = 0
+        pp = lo
+        if f_lo > 0.0 and f_hi <= 0.0:
+            while it < max_iter:
+                it += 1
+                pp = (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
+                if not (lo < pp < hi):
+                    pp = 0.5 * (lo + hi)
+                f = _pump_balance(pp, h, w, p, speeds)
+                if f > 0.0:
+                    lo = pp
+                    f_lo = f
+                    if side == 1:
+                        f_hi *= 0.5
+                    side = 1
+                else:
+                    hi = pp
+                    f_hi = f
+                    if side == -1:
+                        f_lo *= 0.5
+                    side = -1
+                if hi - lo <= tol * (1.0 + pp):
+                    break
+            pp = 0.5 * (lo + hi)
+        f = _pump_balance(pp, h, w, p, speeds)
+        wa = speeds[0]
+        wb = speeds[1]
+        out[k, 0] = pp
+        out[k, 1] = (p[_MOTOR_A_DAMPING] * wa + p[_MOTOR_A_LOAD_TORQUE] * math.tanh(wa / p[_COULOMB_SPEED_WIDTH])) / p[_MOTOR_A_DISPLACEMENT]
+        out[k, 2] = (p[_MOTOR_B_DAMPING] * wb + p[_MOTOR_B_LOAD_TORQUE] * math.tanh(wb / p[_COULOMB_SPEED_WIDTH])) / p[_MOTOR_B_DISPLACEMENT]
+        out[k, 3] = wa
+        out[k, 4] = wb
+        iterations[k] = it
+        residual[k] = abs(f) / _FLOW_SCALE if (hi - lo) > tol * (1.0 + pp) else 0.0
+
+
+@dataclass(frozen=True)
+class SteadyState:
+    """Steady operating points (arrays of one shape, the broadcast shape of the inputs).
+
+    ``state`` has that shape + (5,), in SI units. Speeds are also given in r/min.
+    """
+
+    valve_voltage_v: np.ndarray
+    effective_voltage_v: np.ndarray
+    pump_speed_command_rpm: np.ndarray
+    state: np.ndarray
+    pump_speed_rpm: np.ndarray
+    iterations: np.ndarray
+
+    @property
+    def pump_pressure_pa(self):
+        return self.state[..., 0]
+
+    @property
+    def motor_a_pressure_pa(self):
+        return self.state[..., 1]
+
+    @property
+    def motor_b_pressure_pa(self):
+        return self.state[..., 2]
+
+    @property
+    def motor_a_speed_rpm(self):
+        return self.state[..., 3] * RPM_PER_RAD_S
+
+    @property
+    def motor_b_speed_rpm(self):
+        return self.state[..., 4] * RPM_PER_RAD_S
+
+
+def _check_operating_points(valve_voltage, pump_speed_rpm):
+    v = np.asarray(valve_voltage, dtype=float)
+    w = np.asarray(pump_speed_rpm, dtype=float)
+    if not np.all(np.isfinite(v)):
+        raise ParameterError(f"valve voltage must be a finite number [V], got {v[~np.isfinite(v)].ravel()[0]!r}")
+    if not np.all(np.isfinite(w)):
+        raise ParameterError(f"pump speed must be a finite number [r/min], got {w[~np.isfinite(w)].ravel()[0]!r}")
+    if np.any(w < 0):
+        raise ParameterError(f"pump speed must be >= 0 r/min, got {w[w < 0].ravel()[0]!r}")
+    return np.broadcast_arrays(v, w)
+
+
+def solve_steady_state(parameters: PlantParameters, spool, pump_speed_command, tol=1e-12, max_iter=200):
+    """Raw solver: steady states for arrays of spool positions [m] and pump speed commands [rad/s].
+
+    Returns (state (n, 5), iterations (n,)). Raises SimulationError naming the points that did not
+    converge.
+    """
+    h = np.ascontiguousarray(spool, dtype=np.float64).reshape(-1)
+    w = np.ascontiguousarray(pump_speed_command, dtype=np.float64).reshape(-1)
+    n = h.shape[0]
+    out = np.empty((n, N_STATES))
+    its = np.zeros(n, dtype=np.int64)
+    res = np.zeros(n)
+    _solve_points(h, w, parameters.as_array(), out, its, res, tol, max_iter)
+    bad = ~(res == 0.0)
+    if np.any(bad):
+        k = int(np.argmax(bad))
+        raise SimulationError(
+            f"steady state did not converge at {int(bad.sum())} of {n} operating points; first: spool "
+            f"{h[k]:.4g} m, pump {w[k] * RPM_PER_RAD_S:.1f} r/min (scaled residual {res[k]:.3g} after {its[k]} iterations)"
+        )
+    return out, its
+
+
+def steady_state(
+    parameters: PlantParameters,
+    valve_voltage,
+    pump_speed_rpm,
+    branch: str = "none",
+) -> SteadyState:
+    """Steady state at valve command(s) [V] and pump speed command(s) [r/min] (arrays broadcast).
+
+    branch: ``"none"`` - the averaged valve (no hysteresis, v_eff = v); ``"up"`` - reached by
+    increasing voltage (v_eff = v - r); ``"down"`` - reached by decreasing voltage (v_eff = v + r).
+    """
+    if branch not in BRANCHES:
+        raise ParameterError(f"branch must be one of {list(BRANCHES)}, got {branch!r}")
+    v, w = _check_operating_points(valve_voltage, pump_speed_rpm)
+    r = parameters.hysteresis_half_width
+    offset = {"none": 0.0, "up": -r, "down": r}[branch]
+    v_eff = v + offset
+    state, its = solve_steady_state(parameters, spool_position(v_eff, parameters), w * RAD_S_PER_RPM)
+    state = state.reshape(v.shape + (N_STATES,))
+    wp = pump_speed_actual.py_func(state[..., 0], w * RAD_S_PER_RPM, parameters.as_array())
+    return SteadyState(v, v_eff, w, state, wp * RPM_PER_RAD_S, its.reshape(v.shape))
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    """Up and down steady-state sweeps on a grid (paper section V.A, Figs. 3-5).
+
+    Surfaces are motor A speed [r/min] with shape (n_voltages, n_pump_speeds).
+    """
+
+    voltages_v: np.ndarray
+    pump_speeds_rpm: np.ndarray
+    up_rpm: np.ndarray
+    down_rpm: np.ndarray
+
+    @property
+    def average_rpm(self) -> np.ndarray:
+        """The averaged surface (Fig. 5): the mean of the up and down sweeps, cancelling hysteresis."""
+        return 0.5 * (self.up_rpm + self.down_rpm)
+
+    @property
+    def gap_percent(self) -> np.ndarray:
+        """Normalised hysteresis gap (Fig. 4): (up - down) in % of the full scale of the response."""
+        full_scale = max(np.max(self.up_rpm), np.max(self.down_rpm)) - min(np.min(self.up_rpm), np.min(self.down_rpm))
+        return 100.0 * (self.up_rpm - self.down_rpm) / full_scale if full_scale > 0 else np.zeros_like(self.up_rpm)
+
+    @property
+    def points_per_sweep(self) -> int:
+        return int(self.up_rpm.size)
+
+
+def sweep_effective_voltages(voltages, half_width):
+    """Effective coil commands along an up sweep and a down sweep of ``voltages`` (play operator).
+
+    The up sweep starts from below (the play engaged, v_eff = v_0 - r); the down sweep from above.
+    """
+    v = np.asarray(voltages, dtype=float)
+    up = play_operator(v, half_width, initial=v[0] - half_width)
+    down = play_operator(v[::-1], half_width, initial=v[-1] + half_width)[::-1]
+    return up, down
+
+
+def sweep(
+    parameters: PlantParameters,
+    voltages,
+    pump_speeds_rpm,
+    progress: bool | None = None,
+    chunk_size: int = 256,
+) -> SweepResult:
+    """Up and down steady-state sweeps of the valve command at every pump speed of the grid.
+
+    A sweep with hysteresis is a sequence of steady states of v_eff along the sweep direction
+    (PLANT.md section 7). ``progress=None`` shows a progress bar only on a terminal.
+    """
+    v = np.asarray(voltages, dtype=float).reshape(-1)
+    w = np.asarray(pump_speeds_rpm, dtype=float).reshape(-1)
+    if v.size == 0 or w.size == 0:
+        raise ParameterError("the sweep grid is empty: give at least one voltage and one pump speed")
+    _check_operating_points(v[:, None], w[None, :])
+    up_eff, down_eff = sweep_effective_voltages(v, parameters.hysteresis_half_width)
+    v_eff = np.concatenate([up_eff, down_eff])
+    vv, ww = np.meshgrid(v_eff, w, indexing="ij")
+    spool = spool_position(vv, parameters).ravel()
+    wp = (ww * RAD_S_PER_RPM).ravel()
+    speeds = np.empty(spool.size)
+    if progress is None:
+        progress = sys.stderr.isatty()
+    from tqdm import tqdm
+
+    with tqdm(total=spool.size, desc="steady-state sweep", unit="pt", disable=not progress, leave=False) as bar:
+        for start in range(0, spool.size, chunk_size):
+            stop = min(start + chunk_size, spool.size)
+            state, _ = solve_steady_state(parameters, spool[start:stop], wp[start:stop])
+            speeds[start:stop] = state[:, 3] * RPM_PER_RAD_S
+            bar.update(stop - start)
+    speeds = speeds.reshape(2 * v.size, w.size)
+    return SweepResult(v, w, speeds[: v.size], speeds[v.size:])
