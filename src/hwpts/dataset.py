@@ -61,10 +61,12 @@ class IODataset:
             )
         if len(names) != inputs.shape[1]:
             raise DataError(f"{inputs.shape[1]} input columns but {len(names)} input names {names}")
-        for label, values in (("time", time), ("output", output), ("inputs", inputs)):
+        checks = [("time", time), (str(self.output_name), output)]
+        checks += [(name, inputs[:, j]) for j, name in enumerate(names)]
+        for label, values in checks:
             if not np.all(np.isfinite(values)):
-                bad = int(np.argwhere(~np.isfinite(values.reshape(n, -1)))[0, 0])
-                raise DataError(f"{label} has a non-finite value (NaN or inf) at row {bad}")
+                bad = int(np.argmax(~np.isfinite(values)))
+                raise DataError(f"column {label!r} has a non-finite value (NaN or inf) at row {bad}")
         if n > 1 and not np.all(np.diff(time) > 0):
             bad = int(np.argmax(~(np.diff(time) > 0))) + 1
             raise DataError(f"time must be strictly increasing; it is not at row {bad}")

@@ -112,8 +112,8 @@ def simulate_command(args) -> int:
     if args.case:
         dataset, _ = bed.record(validation_case(args.case), seed=args.seed)
     else:
-        columns = read_table(args.inputs)
         try:
+            columns = read_table(args.inputs)
             inputs = IODataset.from_columns(columns, ["valve_voltage_v", "pump_speed_rpm"], "valve_voltage_v",
                                             time_name="time_s")
             if "time_s" not in columns:

@@ -24,9 +24,9 @@ def read_table(path: str | os.PathLike) -> dict[str, np.ndarray]:
     """Read a table of numeric columns from ``.csv``, ``.parquet`` or ``.mat``."""
     p = Path(path)
     if not p.exists():
-        raise DataError(f"DATA {str(p)!r}: no such file")
+        raise DataError(f"{str(p)!r}: no such file")
     if p.is_dir():
-        raise DataError(f"DATA {str(p)!r}: is a folder, expected a .csv, .parquet or .mat file")
+        raise DataError(f"{str(p)!r}: is a folder, expected a .csv, .parquet or .mat file")
     suffix = p.suffix.lower()
     if suffix == ".csv":
         return read_csv(p)
@@ -35,7 +35,7 @@ def read_table(path: str | os.PathLike) -> dict[str, np.ndarray]:
     if suffix == ".mat":
         return _read_mat(p)
     raise DataError(
-        f"DATA {str(p)!r}: unsupported extension {p.suffix!r}; expected one of {list(SUPPORTED_SUFFIXES)}"
+        f"{str(p)!r}: unsupported extension {p.suffix!r}; expected one of {list(SUPPORTED_SUFFIXES)}"
     )
 
 
