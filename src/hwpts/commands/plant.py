@@ -8,6 +8,9 @@ import numpy as np
 
 from hwpts.commands._args import finite_float, grid, non_negative_float, non_negative_int, output_file
 
+INPUT_COLUMNS = ("time_s", "valve_voltage_v", "pump_speed_rpm")
+"""Columns of an --inputs CSV for ``hwpts plant simulate``."""
+
 
 def register(subparsers) -> None:
     """Add ``hwpts plant`` and its sub-commands."""
@@ -102,7 +105,6 @@ def sweep_command(args) -> int:
 
 
 def simulate_command(args) -> int:
-    from hwpts.dataset import IODataset
     from hwpts.errors import DataError
     from hwpts.io.datasets import read_table, write_csv
     from hwpts.plant import TestBed, validation_case
@@ -114,11 +116,13 @@ def simulate_command(args) -> int:
     else:
         try:
             columns = read_table(args.inputs)
-            inputs = IODataset.from_columns(columns, ["valve_voltage_v", "pump_speed_rpm"], "valve_voltage_v",
-                                            time_name="time_s")
-            if "time_s" not in columns:
-                raise DataError(f"missing column(s) ['time_s']; available columns are {sorted(columns)}")
-            dataset, _ = bed.run(inputs.time, inputs.input("valve_voltage_v"), inputs.input("pump_speed_rpm"),
+        except DataError as error:
+            raise DataError(f"--inputs: {error}") from None
+        try:
+            missing = [c for c in INPUT_COLUMNS if c not in columns]
+            if missing:
+                raise DataError(f"missing column(s) {missing}; available columns are {sorted(columns)}")
+            dataset, _ = bed.run(columns["time_s"], columns["valve_voltage_v"], columns["pump_speed_rpm"],
                                  seed=args.seed)
         except DataError as error:
             raise DataError(f"--inputs {args.inputs!r}: {error}") from None

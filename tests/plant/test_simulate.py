@@ -1,0 +1,87 @@
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from hwpts.errors import DataError, SimulationError
+from hwpts.plant import PlantParameters, simulate_plant, steady_state, validation_case
+from hwpts.plant.dynamics import jacobian, rhs
+from hwpts.plant.valve import play_operator, spool_position
+from hwpts.units import RPM_PER_RAD_S, rpm_to_rad_s
+
+
+def _radau_reference(p, t, v, w_rpm, x0):
+    h = spool_position(play_operator(v, p.hysteresis_half_width), p)
+    x = x0.copy()
+    out = [x]
+    for k in range(t.size - 1):
+        args = (h[k], rpm_to_rad_s(w_rpm[k]))
+        sol = solve_ivp(
+            lambda _, y, hk, wk: rhs(p, y, hk, wk), (t[k], t[k + 1]), x, method="Radau",
+            jac=lambda _, y, hk, wk: jacobian(p, y, hk, wk)[0], rtol=1e-9,
+            atol=[1e-3, 1e-3, 1e-3, 1e-7, 1e-7], args=args,
+        )
+        x = sol.y[:, -1]
+        out.append(x)
+    return np.array(out)
+
+
+def test_matches_a_tight_radau_solution():
+    p = PlantParameters.test_bed()
+    t = np.arange(0, 3.0, 0.01)
+    v = np.where(t < 1.0, 1.8, np.where(t < 2.0, 3.3, 2.4))
+    w = np.where(t < 1.5, 650.0, 850.0)
+    sim = simulate_plant(p, t, v, w)
+    ref = _radau_reference(p, t, v, w, sim.state[0])
+    err_rpm = np.abs(ref[:, 3] - sim.state[:, 3]) * RPM_PER_RAD_S
+    assert err_rpm.max() < 0.5  # r/min, on a response spanning hundreds of r/min
+    assert np.abs(ref[:, 0] - sim.state[:, 0]).max() < 2e3  # Pa, on MPa pressures
+
+
+def test_starts_at_steady_state_and_stays_there():
+    p = PlantParameters.averaged()
+    t = np.arange(0, 2.0, 0.01)
+    sim = simulate_plant(p, t, 2.2, 700.0)
+    s = steady_state(p, 2.2, 700.0)
+    assert np.allclose(sim.motor_a_speed_rpm, float(s.motor_a_speed_rpm), atol=1e-3)
+
+
+def test_stiffness_budget_case4():
+    # SciPy's test_ivp counts evaluations the same way: the solver's work on a standard profile.
+    # An explicit RK45 needs ~1e5 steps per 10 s of this model (PLANT.md section 7).
+    profile = validation_case("case4")
+    sim = simulate_plant(PlantParameters.test_bed(), profile.time, profile.valve_voltage_v, profile.pump_speed_rpm)
+    assert sim.stats.steps < 60_000
+    assert sim.stats.rhs_evaluations < 150_000
+    assert sim.stats.jacobian_evaluations < 80_000
+
+
+def test_spool_lag_adds_a_smooth_sixth_state():
+    p = PlantParameters.averaged().replace(spool_time_constant=0.03)
+    t = np.arange(0, 0.5, 0.005)
+    v = np.where(t < 0.1, 1.5, 3.0)
+    sim = simulate_plant(p, t, v, 700.0)
+    target = float(spool_position(3.0, p))
+    k = np.searchsorted(t, 0.1 + 0.03)  # one time constant after the step
+    assert sim.spool[k] == pytest.approx(float(spool_position(1.5, p)) + (1 - np.exp(-1)) * (target - float(spool_position(1.5, p))), rel=0.02)
+    assert sim.spool[-1] == pytest.approx(target, rel=1e-3)
+
+
+def test_solver_failure_raises_simulation_error():
+    t = np.arange(0, 0.05, 0.01)
+    with pytest.raises(SimulationError, match="integration failed between t = 0 s"):
+        simulate_plant(PlantParameters.paper(), t, 2.0, 500.0, max_step=1e-9)
+
+
+@pytest.mark.parametrize(
+    "time, v, w, match",
+    [
+        ([0.0, 0.1, 0.1], 2.0, 500.0, "strictly increasing"),
+        ([0.0, np.nan], 2.0, 500.0, "time has a non-finite"),
+        ([0.0, 0.1], [2.0, np.nan], 500.0, "valve voltage has a non-finite"),
+        ([0.0, 0.1], 2.0, [500.0, -1.0], "pump speed must be >= 0"),
+        ([], 2.0, 500.0, "time is empty"),
+    ],
+)
+def test_bad_inputs(time, v, w, match):
+    with pytest.raises(DataError, match=match):
+        simulate_plant(PlantParameters.paper(), time, v, w)
