@@ -1,0 +1,96 @@
+"""Accuracy measures used across the field (BENCHMARKS.md).
+
+- :func:`fit_percent`: NRMSE fit ``100 * (1 - ||y - yhat|| / ||y - mean(y)||)``.
+- :func:`rmse`.
+- :func:`region_accuracy`: share of samples in the true mode, under the best one-to-one matching
+  of estimated to true regions (Hungarian algorithm, ``scipy.optimize.linear_sum_assignment``).
+- :func:`parameter_error`: max relative error of the matched ``theta_i``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+
+from hwpts.errors import DataError
+
+__all__ = ["fit_percent", "rmse", "region_accuracy", "best_permutation", "parameter_error"]
+
+
+def _pair(y, yhat):
+    y = np.asarray(y, dtype=float).ravel()
+    yhat = np.asarray(yhat, dtype=float).ravel()
+    if y.shape != yhat.shape:
+        raise DataError(f"measured and predicted outputs differ in length: {y.size} vs {yhat.size}")
+    if y.size == 0:
+        raise DataError("cannot score an empty signal")
+    return y, yhat
+
+
+def fit_percent(y, yhat) -> float:
+    """NRMSE fit in percent; ``nan`` when ``yhat`` is not finite (a diverged simulation).
+
+    Raises :class:`DataError` for a constant ``y`` (the fit is undefined).
+
+    >>> round(fit_percent([1.0, 2.0, 3.0], [1.0, 2.0, 3.5]), 3)
+    64.645
+    """
+    y, yhat = _pair(y, yhat)
+    if not np.all(np.isfinite(yhat)):
+        return float("nan")
+    den = np.linalg.norm(y - y.mean())
+    if den == 0:
+        raise DataError("fit % is undefined for a constant measured output")
+    return float(100.0 * (1.0 - np.linalg.norm(y - yhat) / den))
+
+
+def rmse(y, yhat) -> float:
+    """Root-mean-square error (``nan`` when ``yhat`` is not finite)."""
+    y, yhat = _pair(y, yhat)
+    if not np.all(np.isfinite(yhat)):
+        return float("nan")
+    return float(np.sqrt(np.mean((y - yhat) ** 2)))
+
+
+def best_permutation(true_labels, est_labels, n_true: int | None = None, n_est: int | None = None) -> dict:
+    """Matching estimated region -> true region maximising agreement (``linear_sum_assignment``)."""
+    t = np.asarray(true_labels, dtype=np.int64).ravel()
+    e = np.asarray(est_labels, dtype=np.int64).ravel()
+    n_t = n_true or int(t.max()) + 1
+    n_e = n_est or int(e.max()) + 1
+    counts = np.zeros((n_e, n_t))
+    np.add.at(counts, (e, t), 1)
+    rows, cols = linear_sum_assignment(counts, maximize=True)
+    return {int(r): int(c) for r, c in zip(rows, cols)}
+
+
+def region_accuracy(true_labels, est_labels) -> float:
+    """Share (0..1) of samples whose estimated region matches the true one, best permutation."""
+    t = np.asarray(true_labels, dtype=np.int64).ravel()
+    e = np.asarray(est_labels, dtype=np.int64).ravel()
+    if t.shape != e.shape or t.size == 0:
+        raise DataError(f"label arrays must be non-empty and equal in length: {t.size} vs {e.size}")
+    perm = best_permutation(t, e)
+    mapped = np.array([perm.get(int(v), -1) for v in range(int(e.max()) + 1)])[e]
+    return float(np.mean(mapped == t))
+
+
+def parameter_error(theta_true, theta_est, true_labels=None, est_labels=None) -> float:
+    """Max over matched modes of ||theta_est - theta_true|| / ||theta_true|| (relative, 2-norm).
+
+    Modes are matched by the best permutation of the labels when given, else by the best
+    permutation of the parameter distances.
+    """
+    T = np.atleast_2d(np.asarray(theta_true, dtype=float))
+    E = np.atleast_2d(np.asarray(theta_est, dtype=float))
+    if T.shape[1] != E.shape[1]:
+        raise DataError(f"parameter vectors differ in length: {T.shape[1]} vs {E.shape[1]}")
+    if true_labels is not None and est_labels is not None:
+        perm = best_permutation(true_labels, est_labels, T.shape[0], E.shape[0])
+        pairs = [(e, t) for e, t in perm.items()]
+    else:
+        dist = np.linalg.norm(E[:, None, :] - T[None, :, :], axis=2)
+        rows, cols = linear_sum_assignment(dist)
+        pairs = list(zip(rows, cols))
+    errs = [np.linalg.norm(E[e] - T[t]) / max(np.linalg.norm(T[t]), 1e-12) for e, t in pairs]
+    return float(max(errs))

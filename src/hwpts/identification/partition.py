@@ -1,0 +1,264 @@
+"""Polyhedral partitions of the regressor set (paper eqs. 8-10).
+
+A :class:`RegionPartition` holds, for each region ``i``, the polyhedron (paper eq. 9)::
+
+    chi_i = {x : H_i x + g_i <= 0}
+
+over the standard regression vector ``x_k`` (eq. 7). A regressor belongs to the *first* region
+whose inequalities all hold (so boundaries shared by two closed polyhedra go to the lower index);
+a regressor outside every polyhedron (possible only through rounding, or outside the domain of a
+user-given partition) goes to the region it violates least. The discrete mode of eq. 8 is
+``sigma(k) = predict(x_k)``.
+
+Partitions come from a multicategory linear classifier trained on labelled regressors
+(:func:`fit_linear_partition`: region ``i`` = {x : s_i(x) >= s_j(x) for all j}, with linear scores
+``s_i(x) = w_i' x + b_i``, which is a polyhedron), or from user-given hyperplanes
+(:func:`hyperplane_partition`, the paper's fracture line of eq. 16).
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Sequence
+
+import numpy as np
+
+from hwpts.errors import DataError, ParameterError
+
+__all__ = ["RegionPartition", "fit_linear_partition", "hyperplane_partition", "Hyperplane"]
+
+
+class RegionPartition:
+    """A complete partition of the regressor set into convex polyhedra (paper eq. 9).
+
+    Parameters
+    ----------
+    H : list of ndarray, shape (q_i, n_features)
+    g : list of ndarray, shape (q_i,)
+        Region ``i`` is ``{x : H[i] @ x + g[i] <= 0}``. A region with ``q_i = 0`` is everything.
+    kind : str
+        How it was built (``"linear-classifier"``, ``"hyperplanes"``, ``"single"``); informative.
+    """
+
+    def __init__(self, H: Sequence[np.ndarray], g: Sequence[np.ndarray], kind: str = "polyhedra"):
+        if len(H) != len(g) or len(H) == 0:
+            raise ParameterError(f"a partition needs as many H as g blocks (>= 1); got {len(H)}, {len(g)}")
+        Hs = [np.atleast_2d(np.asarray(h, dtype=float)) for h in H]
+        n = {h.shape[1] for h in Hs if h.size}
+        if len(n) > 1:
+            raise ParameterError(f"polyhedra over different dimensions: {sorted(n)}")
+        self.n_features = n.pop() if n else None
+        if self.n_features is None:
+            self.n_features = Hs[0].shape[1] if Hs[0].ndim == 2 else 0
+        self.H = [h.reshape(-1, self.n_features) for h in Hs]
+        self.g = [np.asarray(gi, dtype=float).reshape(-1) for gi in g]
+        for i, (h, gi) in enumerate(zip(self.H, self.g)):
+            if h.shape[0] != gi.shape[0]:
+                raise ParameterError(f"region {i + 1}: H has {h.shape[0]} rows but g has {gi.shape[0]}")
+            if not (np.all(np.isfinite(h)) and np.all(np.isfinite(gi))):
+                raise ParameterError(f"region {i + 1}: non-finite polyhedron coefficients")
+        self.kind = kind
+        self.scores = None  # (W, b) of the linear classifier when learned: s(x) = W x + b
+
+    def log_proba(self, X: np.ndarray) -> np.ndarray | None:
+        """Log class probabilities (softmax of the classifier scores), or None if not learned."""
+        if self.scores is None:
+            return None
+        W, b = self.scores
+        S = np.asarray(X, dtype=float) @ W.T + b
+        S -= S.max(axis=1, keepdims=True)
+        return S - np.log(np.exp(S).sum(axis=1, keepdims=True))
+
+    @classmethod
+    def single(cls, n_features: int) -> RegionPartition:
+        """The trivial partition: one region, the whole regressor set (plain ARX)."""
+        return cls([np.zeros((0, n_features))], [np.zeros(0)], kind="single")
+
+    @property
+    def n_regions(self) -> int:
+        return len(self.H)
+
+    def violations(self, X: np.ndarray) -> np.ndarray:
+        """Largest constraint value max_q (H_i x + g_i)_q per sample and region, shape (n, s)."""
+        X = np.asarray(X, dtype=float)
+        if X.ndim != 2 or X.shape[1] != self.n_features:
+            raise DataError(f"regressors must have shape (n, {self.n_features}); got {X.shape}")
+        out = np.full((X.shape[0], self.n_regions), -np.inf)
+        for i, (h, gi) in enumerate(zip(self.H, self.g)):
+            if h.shape[0]:
+                out[:, i] = (X @ h.T + gi).max(axis=1)
+        return out
+
+    def predict(self, X: np.ndarray) -> np.ndarray:
+        """Region index (0-based) of each regressor row: first polyhedron containing it (eq. 8)."""
+        v = self.violations(X)
+        inside = v <= 0.0
+        first = np.argmax(inside, axis=1)
+        none = ~inside.any(axis=1)
+        if none.any():
+            first[none] = np.argmin(v[none], axis=1)
+        return first.astype(np.int64)
+
+    def flat(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Stacked rows for compiled loops: H_all (R, n), g_all (R,), row_start (s + 1,)."""
+        counts = [h.shape[0] for h in self.H]
+        row_start = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+        H_all = np.vstack(self.H) if sum(counts) else np.zeros((0, self.n_features))
+        g_all = np.concatenate(self.g) if sum(counts) else np.zeros(0)
+        return np.ascontiguousarray(H_all, dtype=float), np.ascontiguousarray(g_all, dtype=float), row_start
+
+    def to_dict(self) -> dict:
+        return {
+            "kind": self.kind,
+            "rule": "first region i with H_i x + g_i <= 0; else the least violated",
+            "polyhedra": [{"H": h.tolist(), "g": gi.tolist()} for h, gi in zip(self.H, self.g)],
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict, n_features: int) -> RegionPartition:
+        H = [np.asarray(p["H"], dtype=float).reshape(-1, n_features) for p in d["polyhedra"]]
+        g = [np.asarray(p["g"], dtype=float) for p in d["polyhedra"]]
+        return cls(H, g, kind=str(d.get("kind", "polyhedra")))
+
+    def __repr__(self) -> str:
+        rows = [h.shape[0] for h in self.H]
+        return f"RegionPartition(kind={self.kind!r}, n_regions={self.n_regions}, rows={rows})"
+
+
+def scores_to_partition(W: np.ndarray, b: np.ndarray, kind: str = "linear-classifier") -> RegionPartition:
+    """Region i = {x : s_i(x) >= s_j(x) for all j} of linear scores s = W x + b, as polyhedra (eq. 9)."""
+    s = W.shape[0]
+    H, g = [], []
+    for i in range(s):
+        others = [j for j in range(s) if j != i]
+        H.append(W[others] - W[i])
+        g.append(b[others] - b[i])
+    return RegionPartition(H, g, kind=kind)
+
+
+def fit_linear_partition(X: np.ndarray, labels: np.ndarray, n_regions: int, C: float = 1e3,
+                         max_iter: int = 500) -> RegionPartition:
+    """Multicategory linear classifier of regressors into regions, returned as polyhedra (eq. 9).
+
+    Multinomial logistic regression (scikit-learn, L-BFGS) on standardised regressors; the scores
+    are mapped back to the raw coordinates so the polyhedra apply to ``x_k`` directly. Labels must
+    be ``0 .. n_regions-1``; a label without samples gets an empty region (never chosen).
+    """
+    from sklearn.linear_model import LogisticRegression
+
+    X = np.asarray(X, dtype=float)
+    labels = np.asarray(labels, dtype=np.int64)
+    present = np.unique(labels)
+    nf = X.shape[1]
+    if n_regions == 1:
+        return RegionPartition.single(nf)
+    mean = X.mean(axis=0)
+    sd = X.std(axis=0)
+    sd[sd == 0] = 1.0
+    Z = (X - mean) / sd
+    W = np.zeros((n_regions, nf))
+    b = np.full(n_regions, -1e6)  # absent labels: a score that never wins
+    if present.size == 1:
+        b[present[0]] = 0.0
+    else:
+        clf = LogisticRegression(C=C, max_iter=max_iter, tol=1e-6)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # ConvergenceWarning on separable data is harmless here
+            clf.fit(Z, labels)
+        coef, icpt = clf.coef_, clf.intercept_
+        if coef.shape[0] == 1:  # binary: score 0 for the first class, w'z + b for the second
+            coef = np.vstack([np.zeros_like(coef), coef])
+            icpt = np.concatenate([[0.0], icpt])
+        for row, cls_label in enumerate(clf.classes_):
+            W[cls_label] = coef[row] / sd
+            b[cls_label] = icpt[row] - np.dot(coef[row], mean / sd)
+    partition = scores_to_partition(W, b)
+    partition.scores = (W, b)
+    return partition
+
+
+class Hyperplane:
+    """A half-space ``sum_j a_j * x[col_j] + c >= 0`` on named regressor (or input) columns."""
+
+    def __init__(self, coefficients: Sequence[float], offset: float, columns: Sequence[str] | None = None):
+        self.coefficients = tuple(float(a) for a in coefficients)
+        self.offset = float(offset)
+        self.columns = None if columns is None else tuple(str(c) for c in columns)
+        if not self.coefficients:
+            raise ParameterError("a hyperplane needs at least one coefficient")
+        if not all(np.isfinite(self.coefficients)) or not np.isfinite(self.offset):
+            raise ParameterError(f"hyperplane coefficients must be finite, got {self}")
+        if self.columns is not None and len(self.columns) != len(self.coefficients):
+            raise ParameterError(
+                f"hyperplane {self}: {len(self.coefficients)} coefficients for {len(self.columns)} columns"
+            )
+
+    @classmethod
+    def parse(cls, text: str) -> Hyperplane:
+        """Parse ``"a,b,c"`` (a*x1 + b*x2 + c >= 0) or ``"a,b,c@col1,col2"`` (named columns).
+
+        Without ``@``, the columns are the first inputs in order (``"a,c"`` uses the first input).
+        """
+        body, _, cols = str(text).partition("@")
+        try:
+            numbers = [float(v) for v in body.split(",") if v.strip() != ""]
+        except ValueError:
+            raise ParameterError(
+                f"hyperplane {text!r}: expected numbers 'a,b,c' meaning a*x1 + b*x2 + c >= 0"
+            ) from None
+        if len(numbers) < 2:
+            raise ParameterError(f"hyperplane {text!r}: expected at least 'a,c' (a*x1 + c >= 0)")
+        columns = [c.strip() for c in cols.split(",")] if cols else None
+        return cls(numbers[:-1], numbers[-1], columns)
+
+    def resolve(self, structure) -> tuple[np.ndarray, float]:
+        """Coefficient vector over x_k (zeros on other columns) and the offset."""
+        if self.columns is None:
+            if len(self.coefficients) > structure.n_inputs:
+                raise ParameterError(
+                    f"hyperplane {self} has {len(self.coefficients)} coefficients but the model has "
+                    f"{structure.n_inputs} input(s); name the columns with '@col1,col2'"
+                )
+            columns = structure.input_names[: len(self.coefficients)]
+        else:
+            columns = self.columns
+        a = np.zeros(structure.n_features)
+        for coef, col in zip(self.coefficients, columns):
+            a[structure.column_index(col)] += coef
+        return a, self.offset
+
+    def to_dict(self) -> dict:
+        return {"coefficients": list(self.coefficients), "offset": self.offset,
+                "columns": None if self.columns is None else list(self.columns)}
+
+    def __repr__(self) -> str:
+        terms = " + ".join(
+            f"{a:g}*{c}" for a, c in zip(self.coefficients, self.columns or [f"x{i + 1}" for i in range(len(self.coefficients))])
+        )
+        return f"{terms} + {self.offset:g} >= 0"
+
+
+def hyperplane_partition(hyperplanes: Sequence[Hyperplane], structure) -> RegionPartition:
+    """Partition from an ordered list of hyperplanes h_1..h_m, as a decision list (m + 1 regions).
+
+    Region ``j`` (``j = 1..m``) is where ``h_j(x) >= 0`` and no earlier hyperplane holds; region
+    ``m + 1`` is where none holds. Every region is an intersection of half-spaces, hence a convex
+    polyhedron of eq. 9. The paper's partition (eq. 16 and ``h_i >= 3.5 V``) is
+    ``[Hyperplane([1], -3.5, ["h"]), Hyperplane([486.41, 1], -1755.2, ["h", "wp"])]``: region 1 the
+    zero mode, region 2 above the fracture line, region 3 below it.
+    """
+    if not hyperplanes:
+        raise ParameterError("hyperplane segmentation needs at least one hyperplane")
+    resolved = [hp.resolve(structure) for hp in hyperplanes]
+    H, g = [], []
+    for j in range(len(resolved) + 1):
+        rows, offs = [], []
+        for i in range(min(j, len(resolved))):  # earlier hyperplanes do not hold: h_i(x) <= 0
+            rows.append(resolved[i][0])
+            offs.append(resolved[i][1])
+        if j < len(resolved):  # this one holds: -h_j(x) <= 0
+            rows.append(-resolved[j][0])
+            offs.append(-resolved[j][1])
+        H.append(np.array(rows).reshape(-1, structure.n_features))
+        g.append(np.array(offs, dtype=float))
+    return RegionPartition(H, g, kind="hyperplanes")

@@ -1,0 +1,411 @@
+"""The PWARX estimator (paper section IV): segmentation, region estimation, local least squares.
+
+A PWARX model (paper eqs. 5-11) is ``y_k = phi_k' theta_sigma(k) + e_k`` with ``sigma(k) = i`` when
+the regressor ``x_k`` (eq. 7) lies in the polyhedron ``chi_i = {x : H_i x + g_i <= 0}`` (eq. 9).
+:class:`PWARX` estimates it in three steps:
+
+1. **segmentation**: a method from the registry assigns the training samples to regions;
+2. **region estimation**: a multicategory linear classifier turns the labels into polyhedra
+   (eq. 9), then a few rounds of *boundary refinement* move samples to the mode that fits them
+   best (weighted by the classifier's confidence) and refit the classifier;
+3. **regression**: least squares per region (eq. 17), with optional ridge, or constant / zero modes.
+
+It follows the scikit-learn estimator contract (``__init__`` stores, ``fit`` returns ``self``,
+learned attributes end in ``_``). ``predict`` is one step ahead from measured outputs, ``simulate``
+is the free run with the switching rule, ``score`` is the free-run fit %.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+from sklearn.base import BaseEstimator
+from sklearn.utils.validation import check_is_fitted
+
+from hwpts.dataset import IODataset
+from hwpts.errors import DataError, IdentificationError, ParameterError
+from hwpts.identification.local_models import MODEL_KINDS, RegionWarning, fit_local_models
+from hwpts.identification.metrics import fit_percent
+from hwpts.identification.partition import RegionPartition, fit_linear_partition
+from hwpts.identification.regressors import RegressorStructure, validate_signals
+from hwpts.identification.segmentation import AutoSegmenter, make_segmenter
+from hwpts.identification.simulation import SimulationResult, one_step_pwarx, simulate_pwarx
+from hwpts.identification.statespace import mode_state_space
+
+__all__ = ["PWARX", "FreeRunDivergedWarning"]
+
+DIVERGENCE_FACTOR = 50.0
+TRIM = 3.0  # outlier threshold (robust std) of the local least squares of learned partitions
+CONFIDENCE_MARGIN = 4.0  # cost margin for a sample to train the region classifier
+
+
+class FreeRunDivergedWarning(UserWarning):
+    """A free-run simulation left the plausible output band: the model is unstable there."""
+
+
+class PWARX(BaseEstimator):
+    """Piecewise affine ARX model, MISO (paper eqs. 5-11).
+
+    Parameters
+    ----------
+    output_order : int
+        ``na``, number of past outputs in the regressor (eq. 7).
+    input_order : int or list of int
+        ``nb`` per input (samples of each input in the regressor).
+    input_delay : int or list of int
+        ``nk`` per input; ``0`` uses ``u(k)`` as the paper's eq. 18.
+    n_regions : int or "auto"
+        Number of regions ``s`` (ignored by ``average``, ``zscore``, ``hyperplane``; the largest
+        number tried by ``auto``).
+    segmentation : str
+        A name from :data:`hwpts.identification.segmentation.SEGMENTATION_METHODS`.
+    hyperplanes : sequence of str or Hyperplane, optional
+        For ``segmentation="hyperplane"``: ``"a,b,c"`` = ``a*x1 + b*x2 + c >= 0`` on the first
+        two inputs, or ``"a,b,c@col1,col2"`` on named regressor/input columns.
+    region_models : sequence of str, optional
+        ``"affine"`` (default), ``"constant"`` or ``"zero"`` per region (the paper's zero mode).
+    constant : bool
+        Constant term in each mode (eq. 6); ``False`` gives a piecewise linear model.
+    ridge : float
+        Ridge penalty of the local least squares (0 = plain eq. 17).
+    refinement_rounds : int
+        Boundary refinement rounds for learned partitions.
+    classifier_C : float
+        Inverse regularisation of the multinomial logistic region classifier.
+    segmentation_params : dict, optional
+        Keyword parameters of the segmentation method.
+    polish : bool
+        Refine the local parameters by minimising the free-run simulation error on the training
+        data (partition fixed; see :mod:`hwpts.identification.polish`), kept only if better.
+    random_state : int, optional
+        Seed of the numpy ``Generator`` used by randomised methods.
+
+    Attributes
+    ----------
+    structure_ : RegressorStructure
+    partition_ : RegionPartition
+    theta_ : ndarray, shape (n_regions_, n_features + 1)
+        Parameters per mode, offset last.
+    n_regions_ : int
+    region_models_ : tuple of str
+    region_counts_ : ndarray of int
+        Training samples per region.
+    training_labels_ : ndarray of int
+    input_names_, output_name_ : names
+    output_range_ : (float, float)
+    input_ranges_ : ndarray, shape (n_inputs, 2)
+    segmentation_info_ : dict
+    selection_ : list of dict
+        The candidate table of ``segmentation="auto"`` (empty otherwise).
+    """
+
+    def __init__(self, output_order=1, input_order=1, input_delay=1, n_regions=2,
+                 segmentation="clustering", hyperplanes=None, region_models=None, constant=True,
+                 ridge=0.0, refinement_rounds=3, classifier_C=1e3, segmentation_params=None,
+                 polish=False, random_state=None):
+        self.output_order = output_order
+        self.input_order = input_order
+        self.input_delay = input_delay
+        self.n_regions = n_regions
+        self.segmentation = segmentation
+        self.hyperplanes = hyperplanes
+        self.region_models = region_models
+        self.constant = constant
+        self.ridge = ridge
+        self.refinement_rounds = refinement_rounds
+        self.classifier_C = classifier_C
+        self.segmentation_params = segmentation_params
+        self.polish = polish
+        self.random_state = random_state
+
+    # ------------------------------------------------------------------ fitting
+    def _signals(self, X, y, names=None, output_name=None):
+        if isinstance(X, IODataset):
+            if y is not None:
+                raise ParameterError("pass either an IODataset or (inputs, output), not both")
+            return X.inputs, X.output, X.input_names, X.output_name
+        if y is None:
+            raise ParameterError("fit needs the measured output y (or an IODataset)")
+        u, yy = validate_signals(X, y)
+        return u, yy, names, output_name
+
+    def _segmenter(self):
+        params = dict(self.segmentation_params or {})
+        if self.segmentation == "hyperplane":
+            params.setdefault("hyperplanes", tuple(self.hyperplanes or ()))
+        elif self.hyperplanes:
+            raise ParameterError(
+                f"hyperplanes were given but segmentation is {self.segmentation!r}; "
+                f"use segmentation='hyperplane'"
+            )
+        return make_segmenter(self.segmentation, **params)
+
+    def fit(self, X, y=None, input_names=None, output_name=None):
+        """Identify the model from inputs ``X`` (n, n_inputs) and output ``y`` (n,), or an IODataset.
+
+        Returns ``self``.
+        """
+        u, yy, names, oname = self._signals(X, y, input_names, output_name)
+        n_inputs = u.shape[1]
+        names = tuple(names) if names is not None else tuple(f"u{j + 1}" for j in range(n_inputs))
+        structure = RegressorStructure.create(self.output_order, self.input_order, self.input_delay,
+                                              n_inputs, self.constant, names, oname or "y")
+        structure.check_length(yy.shape[0])
+        for j, name in enumerate(names):
+            if structure.nb[j] > 0 and np.ptp(u[:, j]) == 0:
+                raise DataError(
+                    f"input {name!r} is constant ({u[0, j]:.6g}) in the training data: it carries no "
+                    f"information and makes the least squares singular; drop it or use richer data"
+                )
+        if np.ptp(yy) == 0:
+            raise DataError(f"output {structure.output_name!r} is constant in the training data; "
+                            f"there is nothing to identify")
+        segmenter = self._segmenter()
+        rng = np.random.default_rng(self.random_state)
+        self.selection_ = []
+        if isinstance(segmenter, AutoSegmenter):
+            chosen, table = segmenter.select(self, u, yy)
+            self.selection_ = table
+            best = self.__class__(**{**self.get_params(), **chosen})
+            best.fit(u, yy, names, oname)
+            for key, value in vars(best).items():
+                if key.endswith("_") and key != "selection_":
+                    setattr(self, key, value)
+            self.segmentation_info_ = {**best.segmentation_info_, "auto": chosen}
+            return self
+
+        X_reg, target = structure.build(u, yy)
+        n_regions = self.n_regions
+        if segmenter.uses_n_regions:
+            if not isinstance(n_regions, (int, np.integer)) or isinstance(n_regions, bool) or n_regions < 1:
+                raise ParameterError(f"n_regions must be an int >= 1 for {self.segmentation!r}, got {n_regions!r}")
+        seg = segmenter.segment(X_reg, target, n_regions, structure, rng)
+        s = seg.n_regions
+        kinds = self._kinds(s)
+        if seg.partition is not None:
+            partition = seg.partition
+            labels = partition.predict(X_reg)
+        else:
+            labels, partition = self._learn_partition(X_reg, target, seg.labels, s, kinds, seg.refine, structure)
+            s = partition.n_regions
+            kinds = self._kinds(s)
+        learned = seg.partition is None and s > 1
+        local = fit_local_models(X_reg, target, labels, s, structure.constant, kinds, self.ridge,
+                                 trim=TRIM if learned else None)
+        self.structure_ = structure
+        self.partition_ = partition
+        self.theta_ = local.theta
+        self.n_regions_ = s
+        self.region_models_ = tuple(kinds)
+        self.region_counts_ = local.n_samples
+        self.training_labels_ = labels
+        self.condition_ = local.condition
+        self.input_names_ = names
+        self.output_name_ = structure.output_name
+        self.n_features_in_ = n_inputs
+        self.output_range_ = (float(yy.min()), float(yy.max()))
+        self.input_ranges_ = np.column_stack([u.min(axis=0), u.max(axis=0)])
+        self.segmentation_info_ = {"method": str(self.segmentation), **seg.info}
+        if self.polish:
+            from hwpts.identification.polish import polish_free_run
+
+            center, half = self.divergence_band()
+            self.theta_, info = polish_free_run(structure, partition, self.theta_, kinds, u, yy, center, half)
+            self.segmentation_info_["polish"] = info
+        return self
+
+    def _kinds(self, s):
+        if self.region_models is None:
+            return ("affine",) * s
+        kinds = tuple(self.region_models)
+        if len(kinds) != s:
+            raise ParameterError(f"region_models has {len(kinds)} entries but the partition has {s} regions")
+        for kind in kinds:
+            if kind not in MODEL_KINDS:
+                raise ParameterError(f"unknown region model {kind!r}; valid are {list(MODEL_KINDS)}")
+        return kinds
+
+    def _learn_partition(self, X, y, labels, s, kinds, refine, structure):
+        """Region classifier over regressors (eq. 9) and boundary refinement; drops empty regions.
+
+        Each refinement round fits the local models (eq. 17, trimming outliers), scores every
+        sample against every mode with ``cost_ik = r_ik^2 / sigma^2 - log p_i(x_k)`` (residual plus
+        the classifier's confidence, which separates modes with equal parameters), and refits the
+        classifier on the samples whose best mode wins by a clear margin. Ambiguous samples near a
+        boundary carry no information about where it lies, so they are left to the classifier.
+        """
+        labels = np.asarray(labels, dtype=np.int64)
+        partition = fit_linear_partition(X, labels, s, C=self.classifier_C)
+        labels = partition.predict(X)
+        rounds = self.refinement_rounds if (refine and s > 1) else 0
+        p = X.shape[1] + 1
+        for _ in range(rounds):
+            labels, s = self._drop_empty(labels, s)
+            if s == 1:
+                break
+            local = fit_local_models(X, y, labels, s, structure.constant, ("affine",) * s, self.ridge,
+                                     warn=False, trim=TRIM)
+            R = local.residuals(X, y) ** 2
+            assigned = R[np.arange(len(y)), labels]
+            sigma2 = float(np.median(assigned)) / 0.4549 + 1e-12 * (np.var(y) + 1e-300)
+            logp = partition.log_proba(X) if partition.n_regions == s else None
+            cost = R / sigma2 - (logp if logp is not None else 0.0)
+            order = np.sort(cost, axis=1)
+            proposal = np.argmin(cost, axis=1)
+            confident = (order[:, 1] - order[:, 0]) > CONFIDENCE_MARGIN
+            if np.bincount(proposal[confident], minlength=s).min() < p:
+                confident[:] = True
+            partition = fit_linear_partition(X[confident], proposal[confident], s, C=self.classifier_C)
+            new_labels = partition.predict(X)
+            if np.array_equal(new_labels, labels):
+                break
+            labels = new_labels
+        labels2, s2 = self._drop_empty(labels, s)
+        if s2 != s:
+            partition = fit_linear_partition(X, labels2, s2, C=self.classifier_C)
+            labels2 = partition.predict(X)
+        return labels2, partition
+
+    @staticmethod
+    def _drop_empty(labels, s):
+        counts = np.bincount(labels, minlength=s)
+        keep = np.flatnonzero(counts > 0)
+        if keep.size == s:
+            return labels, s
+        warnings.warn(
+            f"{s - keep.size} of {s} regions received no training sample and were dropped; "
+            f"the model has {keep.size} regions", RegionWarning, stacklevel=3,
+        )
+        remap = np.full(s, -1)
+        remap[keep] = np.arange(keep.size)
+        return remap[labels], int(keep.size)
+
+    # ------------------------------------------------------------------ prediction
+    def _check_inputs(self, X, y=None, need_y=True):
+        check_is_fitted(self, "theta_")
+        if isinstance(X, IODataset):
+            if y is not None:
+                raise ParameterError("pass either an IODataset or (inputs, output), not both")
+            X, y = X.inputs, X.output
+        if y is None and need_y:
+            raise ParameterError(
+                f"the measured output is needed (the first {self.structure_.max_lag} samples are "
+                f"the initial conditions)"
+            )
+        u = np.asarray(X, dtype=float)
+        if u.ndim == 1:
+            u = u[:, None]
+        yy = None if y is None else np.asarray(y, dtype=float).ravel()
+        if yy is not None:
+            u, yy = validate_signals(u, yy, self.n_features_in_)
+        elif u.shape[1] != self.n_features_in_:
+            raise DataError(f"expected {self.n_features_in_} input columns, got {u.shape[1]}")
+        return u, yy
+
+    def predict(self, X, y=None) -> np.ndarray:
+        """One-step-ahead prediction from measured past outputs (eq. 5 with measured ``x_k``).
+
+        Returns an array of length n; its first ``max_lag`` entries are the measured outputs.
+        """
+        u, yy = self._check_inputs(X, y)
+        self.structure_.check_length(yy.shape[0])
+        yhat, _ = one_step_pwarx(self.structure_, self.partition_, self.theta_, u, yy)
+        return yhat
+
+    def predict_regions(self, X, y=None) -> np.ndarray:
+        """Region (0-based) of each sample's measured regressor (eq. 8); ``-1`` for the first max_lag."""
+        u, yy = self._check_inputs(X, y)
+        self.structure_.check_length(yy.shape[0])
+        _, regions = one_step_pwarx(self.structure_, self.partition_, self.theta_, u, yy)
+        return regions
+
+    def divergence_band(self) -> tuple[float, float]:
+        """(center, half-width) of the output band beyond which a free run counts as diverged."""
+        lo, hi = self.output_range_
+        center = 0.5 * (lo + hi)
+        half = max(0.5 * (hi - lo), 1e-9 * max(abs(center), 1.0))
+        return center, DIVERGENCE_FACTOR * half
+
+    def simulate(self, X, y=None, initial_output=None) -> SimulationResult:
+        """Free-run simulation with the switching rule (eqs. 5, 8, 10), a :class:`SimulationResult`.
+
+        The first ``max_lag`` outputs are the initial conditions, taken from ``initial_output`` or
+        from the measured ``y``. Numba-compiled: about 10^7 samples per second.
+        """
+        init = initial_output if initial_output is not None else y
+        u, yy = self._check_inputs(X, init, need_y=self.structure_.max_lag > 0 and init is None)
+        m = self.structure_.max_lag
+        y0 = np.zeros(m) if yy is None else yy
+        if y0.shape[0] < m and u.shape[0] > m:
+            raise DataError(f"need {m} initial outputs, got {y0.shape[0]}")
+        center, half = self.divergence_band()
+        return simulate_pwarx(self.structure_, self.partition_, self.theta_, u, y0, center, half)
+
+    def score(self, X, y=None) -> float:
+        """Free-run fit % (NRMSE) after the initial conditions; ``nan`` (with a warning) if diverged."""
+        u, yy = self._check_inputs(X, y)
+        sim = self.simulate(u, yy)
+        m = self.structure_.max_lag
+        if sim.diverged:
+            warnings.warn(sim.reason, FreeRunDivergedWarning, stacklevel=2)
+            return float("nan")
+        return fit_percent(yy[m:], sim.output[m:])
+
+    # ------------------------------------------------------------------ analysis
+    def state_space(self) -> list:
+        """State-space form (eq. 7) of every mode, with its poles (:class:`ModeStateSpace`)."""
+        check_is_fitted(self, "theta_")
+        return [mode_state_space(self.structure_, th) for th in self.theta_]
+
+    def summary(self) -> dict:
+        """JSON-ready description: orders, regions, per-mode sample counts and pole moduli."""
+        check_is_fitted(self, "theta_")
+        regions = []
+        for i, ss in enumerate(self.state_space()):
+            regions.append({
+                "region": i + 1, "model": self.region_models_[i],
+                "n_train_samples": int(self.region_counts_[i]),
+                "max_pole_modulus": round(ss.max_pole_modulus, 6), "stable": ss.stable,
+            })
+        st = self.structure_
+        return {
+            "na": st.na, "nb": list(st.nb), "nk": list(st.nk), "constant": st.constant,
+            "inputs": list(st.input_names), "output": st.output_name,
+            "segmentation": self.segmentation_info_.get("auto", {}).get("segmentation", self.segmentation),
+            "n_regions": int(self.n_regions_), "regions": regions,
+        }
+
+    @classmethod
+    def from_parts(cls, structure: RegressorStructure, partition: RegionPartition, theta, region_models=None,
+                   output_range=None, input_ranges=None, params: dict | None = None,
+                   segmentation_info: dict | None = None) -> PWARX:
+        """A fitted estimator from its parts (a known model, or one read from a model file)."""
+        theta = np.atleast_2d(np.asarray(theta, dtype=float))
+        if theta.shape != (partition.n_regions, structure.n_features + 1):
+            raise ParameterError(
+                f"theta must have shape ({partition.n_regions}, {structure.n_features + 1}); got {theta.shape}"
+            )
+        if partition.n_features != structure.n_features:
+            raise ParameterError(
+                f"partition is over {partition.n_features} regressors, the structure has {structure.n_features}"
+            )
+        est = cls(output_order=structure.na, input_order=list(structure.nb), input_delay=list(structure.nk),
+                  n_regions=partition.n_regions, constant=structure.constant, **(params or {}))
+        est.structure_ = structure
+        est.partition_ = partition
+        est.theta_ = theta
+        est.n_regions_ = partition.n_regions
+        est.region_models_ = tuple(region_models or ("affine",) * partition.n_regions)
+        est.region_counts_ = np.zeros(partition.n_regions, dtype=np.int64)
+        est.training_labels_ = np.zeros(0, dtype=np.int64)
+        est.condition_ = np.full(partition.n_regions, np.nan)
+        est.input_names_ = structure.input_names
+        est.output_name_ = structure.output_name
+        est.n_features_in_ = structure.n_inputs
+        est.output_range_ = tuple(output_range) if output_range is not None else (-1e300, 1e300)
+        est.input_ranges_ = (np.asarray(input_ranges, dtype=float) if input_ranges is not None
+                             else np.full((structure.n_inputs, 2), np.nan))
+        est.segmentation_info_ = dict(segmentation_info or {})
+        est.selection_ = []
+        return est

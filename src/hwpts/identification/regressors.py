@@ -1,0 +1,241 @@
+"""Regression vectors of a MISO ARX / PWARX model (paper eqs. 6-7).
+
+The standard regression vector at sample ``k`` is (paper eq. 7, generalised to an input delay
+``nk_j`` per input, with ``nk_j = 0`` allowed as in the paper's eq. 18 which uses ``h_i(k)``)::
+
+    x_k = [y(k-1) ... y(k-na),
+           u_1(k-nk_1) ... u_1(k-nk_1-nb_1+1),
+           ...,
+           u_p(k-nk_p) ... u_p(k-nk_p-nb_p+1)]'
+
+and the extended regression vector is ``phi_k = [x_k' 1]'`` (eq. 6) when the model has a constant
+term, ``phi_k = x_k`` otherwise (a piecewise *linear* model).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from hwpts.errors import DataError, ParameterError
+
+__all__ = ["RegressorStructure", "as_order_tuple"]
+
+
+def as_order_tuple(value, n_inputs: int, name: str, minimum: int) -> tuple[int, ...]:
+    """An order given as an int (same for every input) or one int per input, as a tuple."""
+    if isinstance(value, (int, np.integer)) and not isinstance(value, bool):
+        values = (int(value),) * n_inputs
+    else:
+        try:
+            values = tuple(int(v) for v in value)
+        except (TypeError, ValueError):
+            raise ParameterError(f"{name} must be an int or a list of ints, got {value!r}") from None
+        if any(int(v) != v for v in value):
+            raise ParameterError(f"{name} must hold integers, got {value!r}")
+        if len(values) != n_inputs:
+            raise ParameterError(
+                f"{name} has {len(values)} entries but there are {n_inputs} inputs; "
+                f"give one int or one per input"
+            )
+    if any(v < minimum for v in values):
+        raise ParameterError(f"{name} must be >= {minimum} for every input, got {list(values)}")
+    return values
+
+
+@dataclass(frozen=True)
+class RegressorStructure:
+    """Orders of a MISO ARX structure and the names of its signals.
+
+    Attributes
+    ----------
+    na : int
+        Output order (number of past outputs), ``>= 0``.
+    nb : tuple of int
+        Input order per input (number of samples of each input), ``>= 0``.
+    nk : tuple of int
+        Input delay per input, ``>= 0`` (``0`` uses ``u(k)``, as the paper's eq. 18).
+    constant : bool
+        Whether the extended regressor ends with a constant 1 (eq. 6: an affine model).
+    input_names, output_name : names used for the regressor column names.
+    """
+
+    na: int
+    nb: tuple[int, ...]
+    nk: tuple[int, ...]
+    constant: bool = True
+    input_names: tuple[str, ...] = ()
+    output_name: str = "y"
+
+    @classmethod
+    def create(cls, na, nb, nk, n_inputs: int, constant: bool = True, input_names=None,
+               output_name: str | None = None) -> RegressorStructure:
+        """Validate orders (int or one per input) and build the structure."""
+        if not isinstance(na, (int, np.integer)) or isinstance(na, bool) or na < 0:
+            raise ParameterError(f"na (output order) must be an int >= 0, got {na!r}")
+        if n_inputs < 1:
+            raise ParameterError(f"need at least one input, got {n_inputs}")
+        nb_t = as_order_tuple(nb, n_inputs, "nb (input order)", 0)
+        nk_t = as_order_tuple(nk, n_inputs, "nk (input delay)", 0)
+        if na == 0 and sum(nb_t) == 0:
+            raise ParameterError("na=0 and nb=0 for every input leave an empty regressor")
+        names = tuple(input_names) if input_names is not None else tuple(
+            f"u{j + 1}" for j in range(n_inputs))
+        if len(names) != n_inputs:
+            raise ParameterError(f"{len(names)} input names for {n_inputs} inputs")
+        return cls(int(na), nb_t, nk_t, bool(constant), names, output_name or "y")
+
+    @property
+    def n_inputs(self) -> int:
+        return len(self.nb)
+
+    @property
+    def max_lag(self) -> int:
+        """Number of initial samples needed before the first regressor (initial conditions)."""
+        lags = [self.na] + [nk + nb - 1 for nb, nk in zip(self.nb, self.nk) if nb > 0]
+        return max(0, *lags)
+
+    @property
+    def n_features(self) -> int:
+        """Length of the standard regression vector x_k (eq. 7)."""
+        return self.na + sum(self.nb)
+
+    @property
+    def n_parameters(self) -> int:
+        """Length of the extended regression vector phi_k (eq. 6) = parameters per mode."""
+        return self.n_features + int(self.constant)
+
+    @property
+    def min_samples(self) -> int:
+        """Fewest samples giving as many equations as one mode has parameters."""
+        return self.max_lag + self.n_parameters
+
+    def describe_orders(self) -> str:
+        nb = self.nb[0] if len(set(self.nb)) == 1 else list(self.nb)
+        nk = self.nk[0] if len(set(self.nk)) == 1 else list(self.nk)
+        return f"na={self.na}, nb={nb}, nk={nk}"
+
+    def check_length(self, n_samples: int, what: str = "DATA") -> None:
+        """Raise :class:`DataError` when ``n_samples`` is too short for these orders."""
+        if n_samples < self.min_samples:
+            raise DataError(
+                f"{self.describe_orders()} needs at least {self.min_samples} samples "
+                f"({self.max_lag} initial conditions + {self.n_parameters} parameters); "
+                f"{what} has {n_samples} rows"
+            )
+
+    @property
+    def feature_names(self) -> list[str]:
+        """Names of the columns of x_k, e.g. ``y(k-1)``, ``u1(k)``, ``u1(k-1)``."""
+        names = [f"{self.output_name}(k-{i})" for i in range(1, self.na + 1)]
+        for name, nb, nk in zip(self.input_names, self.nb, self.nk):
+            for lag in range(nk, nk + nb):
+                names.append(f"{name}(k)" if lag == 0 else f"{name}(k-{lag})")
+        return names
+
+    @property
+    def lags(self) -> tuple[np.ndarray, np.ndarray]:
+        """For each column of x_k: the signal index (-1 = output, j = input j) and the lag."""
+        sig, lag = [], []
+        for i in range(1, self.na + 1):
+            sig.append(-1)
+            lag.append(i)
+        for j, (nb, nk) in enumerate(zip(self.nb, self.nk)):
+            for lg in range(nk, nk + nb):
+                sig.append(j)
+                lag.append(lg)
+        return np.asarray(sig, dtype=np.int64), np.asarray(lag, dtype=np.int64)
+
+    def column_index(self, name: str) -> int:
+        """Index in x_k of a regressor column, by regressor name (``u1(k-1)``) or input name.
+
+        An input name refers to that input's most recent sample in the regressor (``u(k-nk)``);
+        the output name refers to ``y(k-1)``.
+        """
+        names = self.feature_names
+        if name in names:
+            return names.index(name)
+        if name in self.input_names:
+            j = self.input_names.index(name)
+            if self.nb[j] == 0:
+                raise ParameterError(f"input {name!r} has nb=0: it is not in the regressor")
+            return self.na + sum(self.nb[:j])
+        if name == self.output_name and self.na > 0:
+            return 0
+        raise ParameterError(
+            f"unknown regressor column {name!r}; valid names are {names} or the inputs "
+            f"{list(self.input_names)}"
+        )
+
+    def build(self, inputs: np.ndarray, output: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Regressor matrix X (rows x_k', eq. 7) and targets y(k), for k = max_lag .. n-1."""
+        u = np.asarray(inputs, dtype=float)
+        if u.ndim == 1:
+            u = u[:, None]
+        y = np.asarray(output, dtype=float)
+        if u.ndim != 2 or u.shape[1] != self.n_inputs:
+            raise DataError(f"inputs must have shape (n_samples, {self.n_inputs}); got {u.shape}")
+        if y.ndim != 1 or y.shape[0] != u.shape[0]:
+            raise DataError(f"output must have shape ({u.shape[0]},); got {y.shape}")
+        n = y.shape[0]
+        self.check_length(n)
+        m = self.max_lag
+        rows = n - m
+        X = np.empty((rows, self.n_features))
+        col = 0
+        for i in range(1, self.na + 1):
+            X[:, col] = y[m - i : n - i]
+            col += 1
+        for j, (nb, nk) in enumerate(zip(self.nb, self.nk)):
+            for lg in range(nk, nk + nb):
+                X[:, col] = u[m - lg : n - lg, j]
+                col += 1
+        return X, y[m:].copy()
+
+    def extend(self, X: np.ndarray) -> np.ndarray:
+        """Extended regressors phi_k = [x_k' 1]' (eq. 6), or x_k without a constant term."""
+        if not self.constant:
+            return X
+        return np.hstack([X, np.ones((X.shape[0], 1))])
+
+    def to_dict(self) -> dict:
+        return {
+            "na": self.na, "nb": list(self.nb), "nk": list(self.nk), "constant": self.constant,
+            "input_names": list(self.input_names), "output_name": self.output_name,
+            "regressor_names": self.feature_names,
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict) -> RegressorStructure:
+        return cls.create(d["na"], d["nb"], d["nk"], len(d["input_names"]), d["constant"],
+                          d["input_names"], d["output_name"])
+
+
+def validate_signals(inputs, output, n_inputs: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Inputs as (n, p) float array and output as (n,) float array, finite, same length."""
+    u = np.asarray(inputs, dtype=float)
+    if u.ndim == 1:
+        u = u[:, None]
+    y = np.asarray(output, dtype=float)
+    if u.ndim != 2:
+        raise DataError(f"inputs must be 2-D (n_samples, n_inputs); got shape {u.shape}")
+    if y.ndim != 1:
+        raise DataError(f"output must be 1-D; got shape {y.shape}")
+    if u.shape[0] != y.shape[0]:
+        raise DataError(f"inputs have {u.shape[0]} rows but output has {y.shape[0]}")
+    if n_inputs is not None and u.shape[1] != n_inputs:
+        raise DataError(f"expected {n_inputs} input columns, got {u.shape[1]}")
+    for label, arr in (("inputs", u), ("output", y)):
+        bad = ~np.isfinite(arr)
+        if bad.any():
+            row = int(np.argwhere(bad.reshape(arr.shape[0], -1))[0, 0])
+            raise DataError(f"{label} has a non-finite value (NaN or inf) at row {row}")
+    return u, y
+
+
+def names_or_default(names: Sequence[str] | None, n: int, prefix: str) -> tuple[str, ...]:
+    if names is None:
+        return tuple(f"{prefix}{j + 1}" for j in range(n))
+    return tuple(str(x) for x in names)

@@ -1,0 +1,20 @@
+"""``average``: every sample in one region, i.e. a single affine ARX model (the paper's baseline)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hwpts.identification.segmentation.base import SegmentationResult, Segmenter
+
+
+class AverageSegmenter(Segmenter):
+    """One region for all data (paper section V.B "average" method): plain least-squares ARX."""
+
+    name = "average"
+    uses_n_regions = False
+
+    def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
+        from hwpts.identification.partition import RegionPartition
+
+        return SegmentationResult(np.zeros(X.shape[0], dtype=np.int64), 1,
+                                  RegionPartition.single(X.shape[1]), refine=False)

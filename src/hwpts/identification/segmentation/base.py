@@ -1,0 +1,70 @@
+"""What every segmentation method returns, and the shared base class."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from hwpts.errors import ParameterError
+
+
+@dataclass
+class SegmentationResult:
+    """Training samples assigned to regions.
+
+    Attributes
+    ----------
+    labels : ndarray of int, shape (n_rows,)
+        Region (0-based) of each training regressor row.
+    n_regions : int
+    partition : RegionPartition or None
+        A partition fixed by the method itself (hyperplanes); ``None`` means the estimator learns
+        one with a multicategory linear classifier over the regressors (paper eq. 9).
+    refine : bool
+        Whether the estimator may move samples between regions afterwards (boundary refinement).
+    info : dict
+        Method diagnostics (iterations, objective...), JSON-serialisable.
+    """
+
+    labels: np.ndarray
+    n_regions: int
+    partition: object = None
+    refine: bool = True
+    info: dict = field(default_factory=dict)
+
+
+class Segmenter:
+    """Base class: ``__init__`` stores keyword parameters only; :meth:`segment` does the work.
+
+    ``segment(X, y, n_regions, structure, rng)`` receives the standard regressors ``X`` (eq. 7),
+    targets ``y``, the requested number of regions, the :class:`RegressorStructure` and a numpy
+    ``Generator``; it returns a :class:`SegmentationResult`.
+    """
+
+    name = "base"
+    #: whether the method takes the number of regions from the caller
+    uses_n_regions = True
+
+    def get_params(self) -> dict:
+        return {k: v for k, v in vars(self).items() if not k.startswith("_")}
+
+    def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:  # pragma: no cover
+        raise NotImplementedError
+
+    def _check_regions(self, n_regions, n_rows):
+        if not isinstance(n_regions, (int, np.integer)) or n_regions < 1:
+            raise ParameterError(f"n_regions must be an int >= 1, got {n_regions!r}")
+        if n_regions > n_rows:
+            raise ParameterError(f"n_regions={n_regions} exceeds the {n_rows} training regressors")
+
+    def __repr__(self) -> str:
+        params = ", ".join(f"{k}={v!r}" for k, v in self.get_params().items())
+        return f"{type(self).__name__}({params})"
+
+
+def standardize(X: np.ndarray) -> np.ndarray:
+    """Columns scaled to zero mean and unit standard deviation (constant columns left at 0)."""
+    sd = X.std(axis=0)
+    sd[sd == 0] = 1.0
+    return (X - X.mean(axis=0)) / sd

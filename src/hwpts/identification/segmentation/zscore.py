@@ -1,0 +1,38 @@
+"""``zscore``: two partitions by the z-score of the observations (paper section V.B).
+
+The z-score of an observation is ``z_k = (y_k - mean(y)) / std(y)``. Region 1 holds the samples with
+``z_k < threshold``, region 2 those with ``z_k >= threshold`` (default threshold 0: below / above
+the mean level). A two-sided split ``|z_k| > threshold`` would not be a convex polyhedron of the
+regressor set (eq. 9), so the one-sided split is used; the regions seen by the switching rule are
+then the best linear separation of these labels over the regressors.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hwpts.errors import IdentificationError, ParameterError
+from hwpts.identification.segmentation.base import SegmentationResult, Segmenter
+
+
+class ZScoreSegmenter(Segmenter):
+    name = "zscore"
+    uses_n_regions = False
+
+    def __init__(self, threshold: float = 0.0):
+        self.threshold = threshold
+
+    def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
+        if not np.isfinite(self.threshold):
+            raise ParameterError(f"zscore threshold must be finite, got {self.threshold!r}")
+        sd = float(np.std(y))
+        if sd == 0:
+            raise IdentificationError("zscore segmentation needs a non-constant output")
+        z = (y - y.mean()) / sd
+        labels = (z >= self.threshold).astype(np.int64)
+        if labels.min() == labels.max():
+            raise IdentificationError(
+                f"zscore threshold {self.threshold} leaves a region empty; choose a threshold "
+                f"between {z.min():.3g} and {z.max():.3g}"
+            )
+        return SegmentationResult(labels, 2, info={"threshold": float(self.threshold)})
