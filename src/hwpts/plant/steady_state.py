@@ -3,8 +3,10 @@
 The static equations have a monotone structure that makes them solvable exactly and without
 initial guesses: for a given pump pressure P_p each motor branch has one shaft speed balancing its
 flow (the orifice flow falls and the motor's demand rises with speed), and the pump-line balance
-falls monotonically in P_p. So each point is a bracketed 1-D solve on P_p (Illinois regula falsi)
-around bracketed 1-D solves of the two branches. Newton on the full 5-state system cycles across
+falls monotonically in P_p. So each point is a bracketed 1-D solve on P_p around bracketed 1-D
+solves of the two branches, each a Newton iteration with analytic derivatives (the outer one through
+the branches' implicit dependence on P_p) that falls back to bisection whenever a step would leave
+the bracket, so it always converges. Newton on the full 5-state system cycles across
 the check-valve kink near the fracture line; this cannot. Compiled with numba; the points are independent,
 so a sweep is a map over chunks of points (PLANT.md section 7).
 """
@@ -22,7 +24,15 @@ from hwpts.errors import ParameterError, SimulationError
 from hwpts.plant.dynamics import N_STATES, pump_speed_actual
 from hwpts.plant.parameters import PARAMETER_INDEX as _I
 from hwpts.plant.parameters import PlantParameters
-from hwpts.plant.valve import MAKEUP_SMOOTHING_PA, orifice_shape, play_operator, smooth_max0, spool_position
+from hwpts.plant.valve import (
+    MAKEUP_SMOOTHING_PA,
+    orifice_shape,
+    orifice_shape_derivative,
+    play_operator,
+    smooth_max0,
+    smooth_max0_derivative,
+    spool_position,
+)
 from hwpts.units import RAD_S_PER_RPM, RPM_PER_RAD_S
 
 BRANCHES = ("none", "up", "down")
@@ -94,48 +104,72 @@ def solve_linear_inplace(a, b):
 
 
 @numba.njit(cache=True)
-def _branch_residual(w, pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu, eps_mu):
-    """Flow balance of one motor branch at shaft speed w, supply pressure pp (decreasing in w)."""
-    pm = (damping * w + torque * math.tanh(w / ws)) / dm
-    q = c * area * orifice_shape(pp - pm - opening, pcr, eps)
-    return q + kmu * smooth_max0(-pm, eps_mu) - dm * w - cs * pm
+def _branch(w, pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu, out):
+    """Flow balance g of one motor branch at shaft speed w and supply pressure pp (g falls with w).
+
+    Writes (g, dg/dw, dg/dpp, dQ/dpp at fixed w, dQ/dw) into out; returns the orifice flow Q.
+    """
+    th = math.tanh(w / ws)
+    pm = (damping * w + torque * th) / dm
+    dpm = (damping + torque / ws * (1.0 - th * th)) / dm
+    dp = pp - pm - opening
+    q = c * area * orifice_shape(dp, pcr, eps)
+    dq = c * area * orifice_shape_derivative(dp, pcr, eps)
+    mu = kmu * smooth_max0(-pm, MAKEUP_SMOOTHING_PA)
+    dmu = kmu * smooth_max0_derivative(-pm, MAKEUP_SMOOTHING_PA)
+    out[0] = q + mu - dm * w - cs * pm
+    out[1] = -dq * dpm - dmu * dpm - dm - cs * dpm
+    out[2] = dq
+    out[3] = dq
+    out[4] = -dq * dpm
+    return q
 
 
 @numba.njit(cache=True)
-def _branch_speed(pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu, eps_mu):
-    """The unique shaft speed balancing a motor branch (Illinois regula falsi on a bracket)."""
+def _branch_speed(pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu, out, guess):
+    """The unique shaft speed balancing a motor branch: safeguarded Newton on a bracket.
+
+    ``guess`` (e.g. the solution at a nearby pressure) starts the iteration when inside the
+    bracket. On return out holds the branch's derivatives at the solution (see :func:`_branch`).
+    """
     lo = -1.0
-    f_lo = _branch_residual(lo, pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu, eps_mu)
     hi = max(pp, 1.0) * dm / damping + 10.0
-    f_hi = _branch_residual(hi, pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu, eps_mu)
-    if f_lo <= 0.0:
+    _branch(lo, pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu, out)
+    if out[0] <= 0.0:
         return lo
-    side = 0
+    w = guess if lo < guess < hi else min(max(pp - opening, 0.0) * dm * dm / (damping * dm + 1e-3), 0.5 * hi)
+    dx_old = hi - lo
+    dx = dx_old
     for _ in range(200):
-        w = (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
-        if not (lo < w < hi):
-            w = 0.5 * (lo + hi)
-        f = _branch_residual(w, pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu, eps_mu)
-        if f > 0.0:
+        _branch(w, pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu, out)
+        g = out[0]
+        dg = out[1]
+        if g > 0.0:
             lo = w
-            f_lo = f
-            if side == 1:
-                f_hi *= 0.5
-            side = 1
         else:
             hi = w
-            f_hi = f
-            if side == -1:
-                f_lo *= 0.5
-            side = -1
-        if hi - lo <= 1e-12 * (1.0 + abs(w)):
+        newton = w - g / dg if dg < 0.0 else lo - 1.0
+        # rtsafe (Numerical Recipes): bisect when Newton leaves the bracket or does not halve the step
+        if not (lo < newton < hi) or abs(2.0 * g) > abs(dx_old * dg):
+            dx_old = dx
+            dx = 0.5 * (hi - lo)
+            w = lo + dx
+        else:
+            dx_old = dx
+            dx = newton - w
+            w = newton
+        if abs(dx) <= 1e-12 * (1.0 + abs(w)):
             break
-    return 0.5 * (lo + hi)
+    _branch(w, pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu, out)
+    return w
 
 
 @numba.njit(cache=True)
-def _pump_balance(pp, h, wp_cmd, p, speeds):
-    """Pump-line flow balance at pump pressure pp (decreasing in pp); writes the shaft speeds."""
+def _pump_balance(pp, h, wp_cmd, p, speeds, work):
+    """Pump-line flow balance G at pump pressure pp (G falls with pp); writes the shaft speeds.
+
+    Returns G; work[0] receives dG/dpp, through each branch's implicit dependence w(pp).
+    """
     c = p[_DISCHARGE_COEFFICIENT] * math.sqrt(2.0 / p[_OIL_DENSITY])
     frac = h / p[_SPOOL_STROKE]
     area_a = p[_MAX_ORIFICE_AREA] * (1.0 - frac) + p[_LEAK_AREA]
@@ -143,77 +177,85 @@ def _pump_balance(pp, h, wp_cmd, p, speeds):
     eps = p[_SMOOTHING_PRESSURE]
     pcr = p[_ORIFICE_TRANSITION_PRESSURE]
     kmu = p[_MAKEUP_GAIN]
+    ws = p[_COULOMB_SPEED_WIDTH]
+    out = work[1:]
     wa = _branch_speed(pp, area_a, 0.0, p[_MOTOR_A_DISPLACEMENT], p[_MOTOR_A_LEAKAGE], p[_MOTOR_A_DAMPING],
-                       p[_MOTOR_A_LOAD_TORQUE], p[_COULOMB_SPEED_WIDTH], c, pcr, eps, kmu, MAKEUP_SMOOTHING_PA)
+                       p[_MOTOR_A_LOAD_TORQUE], ws, c, pcr, eps, kmu, out, speeds[0])
+    qa = c * area_a * orifice_shape(pp - (p[_MOTOR_A_DAMPING] * wa + p[_MOTOR_A_LOAD_TORQUE] * math.tanh(wa / ws))
+                                    / p[_MOTOR_A_DISPLACEMENT], pcr, eps)
+    dqa = out[3] + out[4] * (-out[2] / out[1])
     wb = _branch_speed(pp, area_b, p[_AUX_OPENING_PRESSURE], p[_MOTOR_B_DISPLACEMENT], p[_MOTOR_B_LEAKAGE],
-                       p[_MOTOR_B_DAMPING], p[_MOTOR_B_LOAD_TORQUE], p[_COULOMB_SPEED_WIDTH], c, pcr, eps,
-                       kmu, MAKEUP_SMOOTHING_PA)
+                       p[_MOTOR_B_DAMPING], p[_MOTOR_B_LOAD_TORQUE], ws, c, pcr, eps, kmu, out, speeds[1])
+    qb = c * area_b * orifice_shape(pp - (p[_MOTOR_B_DAMPING] * wb + p[_MOTOR_B_LOAD_TORQUE] * math.tanh(wb / ws))
+                                    / p[_MOTOR_B_DISPLACEMENT] - p[_AUX_OPENING_PRESSURE], pcr, eps)
+    dqb = out[3] + out[4] * (-out[2] / out[1])
     speeds[0] = wa
     speeds[1] = wb
-    pa = (p[_MOTOR_A_DAMPING] * wa + p[_MOTOR_A_LOAD_TORQUE] * math.tanh(wa / p[_COULOMB_SPEED_WIDTH])) / p[_MOTOR_A_DISPLACEMENT]
-    pb = (p[_MOTOR_B_DAMPING] * wb + p[_MOTOR_B_LOAD_TORQUE] * math.tanh(wb / p[_COULOMB_SPEED_WIDTH])) / p[_MOTOR_B_DISPLACEMENT]
-    qa = c * area_a * orifice_shape(pp - pa, pcr, eps)
-    qb = c * area_b * orifice_shape(pp - pb - p[_AUX_OPENING_PRESSURE], pcr, eps)
     wp = wp_cmd - p[_DROOP_GAIN] * p[_PUMP_DISPLACEMENT] * pp
     qp = p[_PUMP_DISPLACEMENT] * wp - p[_PUMP_LEAKAGE] * pp
     qrv = p[_RELIEF_GAIN] * smooth_max0(pp - p[_RELIEF_PRESSURE], eps)
+    work[0] = (-p[_PUMP_DISPLACEMENT] * p[_DROOP_GAIN] * p[_PUMP_DISPLACEMENT] - p[_PUMP_LEAKAGE]
+               - kmu * smooth_max0_derivative(-pp, MAKEUP_SMOOTHING_PA) - dqa - dqb
+               - p[_RELIEF_GAIN] * smooth_max0_derivative(pp - p[_RELIEF_PRESSURE], eps))
     return qp + kmu * smooth_max0(-pp, MAKEUP_SMOOTHING_PA) - qa - qb - qrv
 
 
 @numba.njit(cache=True)
 def _solve_points(spool, wp_cmd, p, out, iterations, residual, tol, max_iter):
-    """Steady state of each point: outer bracketed solve on P_p, inner on each shaft speed."""
+    """Steady state of each point: safeguarded Newton on P_p around the branches' own solves."""
     n = spool.shape[0]
     speeds = np.empty(2)
+    work = np.empty(6)
     for k in range(n):
         h = spool[k]
         w = wp_cmd[k]
+        speeds[0] = -10.0  # no warm start for the first branch solves of a point
+        speeds[1] = -10.0
         lo = 0.0
-        f_lo = _pump_balance(lo, h, w, p, speeds)
         hi = p[_RELIEF_PRESSURE]
-        f_hi = _pump_balance(hi, h, w, p, speeds)
+        f_hi = _pump_balance(hi, h, w, p, speeds, work)
         grow = 0
         while f_hi > 0.0 and grow < 60:
             lo = hi
-            f_lo = f_hi
             hi *= 2.0
-            f_hi = _pump_balance(hi, h, w, p, speeds)
+            f_hi = _pump_balance(hi, h, w, p, speeds, work)
             grow += 1
+        pp = lo if grow else 0.5 * hi
+        dx_old = hi - lo
+        dx = dx_old
         it = 0
-        side = 0
-        pp = lo
-        if f_lo > 0.0 and f_hi <= 0.0:
-            while it < max_iter:
-                it += 1
-                pp = (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
-                if not (lo < pp < hi):
-                    pp = 0.5 * (lo + hi)
-                f = _pump_balance(pp, h, w, p, speeds)
-                if f > 0.0:
-                    lo = pp
-                    f_lo = f
-                    if side == 1:
-                        f_hi *= 0.5
-                    side = 1
-                else:
-                    hi = pp
-                    f_hi = f
-                    if side == -1:
-                        f_lo *= 0.5
-                    side = -1
-                if hi - lo <= tol * (1.0 + pp):
-                    break
-            pp = 0.5 * (lo + hi)
-        f = _pump_balance(pp, h, w, p, speeds)
+        converged = False
+        while it < max_iter:
+            it += 1
+            f = _pump_balance(pp, h, w, p, speeds, work)
+            df = work[0]
+            if f > 0.0:
+                lo = pp
+            else:
+                hi = pp
+            newton = pp - f / df if df < 0.0 else lo - 1.0
+            if not (lo < newton < hi) or abs(2.0 * f) > abs(dx_old * df):
+                dx_old = dx
+                dx = 0.5 * (hi - lo)
+                pp = lo + dx
+            else:
+                dx_old = dx
+                dx = newton - pp
+                pp = newton
+            if abs(dx) <= tol * (1.0 + pp):
+                converged = True
+                break
+        f = _pump_balance(pp, h, w, p, speeds, work)
         wa = speeds[0]
         wb = speeds[1]
+        ws = p[_COULOMB_SPEED_WIDTH]
         out[k, 0] = pp
-        out[k, 1] = (p[_MOTOR_A_DAMPING] * wa + p[_MOTOR_A_LOAD_TORQUE] * math.tanh(wa / p[_COULOMB_SPEED_WIDTH])) / p[_MOTOR_A_DISPLACEMENT]
-        out[k, 2] = (p[_MOTOR_B_DAMPING] * wb + p[_MOTOR_B_LOAD_TORQUE] * math.tanh(wb / p[_COULOMB_SPEED_WIDTH])) / p[_MOTOR_B_DISPLACEMENT]
+        out[k, 1] = (p[_MOTOR_A_DAMPING] * wa + p[_MOTOR_A_LOAD_TORQUE] * math.tanh(wa / ws)) / p[_MOTOR_A_DISPLACEMENT]
+        out[k, 2] = (p[_MOTOR_B_DAMPING] * wb + p[_MOTOR_B_LOAD_TORQUE] * math.tanh(wb / ws)) / p[_MOTOR_B_DISPLACEMENT]
         out[k, 3] = wa
         out[k, 4] = wb
         iterations[k] = it
-        residual[k] = abs(f) / _FLOW_SCALE if (hi - lo) > tol * (1.0 + pp) else 0.0
+        residual[k] = 0.0 if converged else abs(f) / _FLOW_SCALE
 
 
 @dataclass(frozen=True)
