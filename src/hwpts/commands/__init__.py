@@ -8,3 +8,4 @@ subclasses for bad input; :func:`hwpts.cli.main` prints them as one line with ex
 from hwpts.commands import plant as _plant
 
 COMMAND_MODULES = [_plant]
+from hwpts.commands import model as _model; COMMAND_MODULES.append(_model)  # noqa: E702 - identify/validate/predict

@@ -1,0 +1,214 @@
+"""PWARX model files: JSON, schema ``"hwpts.pwarx/1"`` (DESIGN.md section 5). No pickle.
+
+A model file holds the orders and signal names (``structure``), one entry per region with its
+parameters ``theta`` (eq. 5, offset last) and model kind, the partition as polyhedra
+``{x : H_i x + g_i <= 0}`` (eq. 9), the training ranges, and a SHA-256 checksum of those numeric
+sections. :func:`load_model` validates everything and refuses, with a :class:`DataError` naming
+the problem, a file of another schema, with missing keys, wrong shapes, non-finite numbers or
+numbers edited after saving (checksum mismatch).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+
+from hwpts.errors import DataError, HwptsError
+
+SCHEMA = "hwpts.pwarx/1"
+CHECKED_SECTIONS = ("structure", "regions", "partition", "training")
+
+__all__ = ["SCHEMA", "model_to_dict", "model_from_dict", "save_model", "load_model", "dumps_model"]
+
+
+def _jsonable(value):
+    """Plain JSON types from numpy scalars/arrays, tuples and nested containers."""
+    if isinstance(value, dict):
+        return {str(k): _jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_jsonable(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return _jsonable(value.tolist())
+    if isinstance(value, (np.bool_, bool)):
+        return bool(value)
+    if isinstance(value, (np.integer,)):
+        return int(value)
+    if isinstance(value, (np.floating, float)):
+        v = float(value)
+        return v if math.isfinite(v) else None
+    return value
+
+
+def checksum(doc: dict) -> str:
+    """SHA-256 of the canonical JSON of the numeric sections (sorted keys, no spaces)."""
+    payload = {k: doc.get(k) for k in CHECKED_SECTIONS}
+    text = json.dumps(payload, sort_keys=True, separators=(",", ":"), allow_nan=False)
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()
+
+
+def model_to_dict(model) -> dict:
+    """The JSON document of a fitted :class:`~hwpts.identification.PWARX`."""
+    from hwpts import __version__
+
+    st = model.structure_
+    regions = []
+    for i, ss in enumerate(model.state_space()):
+        regions.append({
+            "region": i + 1,
+            "model": model.region_models_[i],
+            "theta": [float(v) for v in model.theta_[i]],
+            "n_train_samples": int(model.region_counts_[i]),
+            "max_pole_modulus": float(ss.max_pole_modulus),
+            "stable": bool(ss.stable),
+        })
+    doc = {
+        "schema": SCHEMA,
+        "generator": f"hwpts {__version__}",
+        "structure": _jsonable(st.to_dict()),
+        "regions": regions,
+        "partition": _jsonable(model.partition_.to_dict()),
+        "training": {
+            "output_range": [float(v) for v in model.output_range_],
+            "input_ranges": [[float(a), float(b)] for a, b in np.asarray(model.input_ranges_)],
+            "n_samples": int(np.sum(model.region_counts_)) + st.max_lag,
+        },
+        "segmentation": _jsonable({"method": model.summary()["segmentation"], **model.segmentation_info_}),
+    }
+    doc["checksum"] = {"algorithm": "sha256", "sections": list(CHECKED_SECTIONS), "value": checksum(doc)}
+    return doc
+
+
+def dumps_model(model) -> str:
+    return json.dumps(model_to_dict(model), indent=1, allow_nan=False) + "\n"
+
+
+def save_model(model, path: str | os.PathLike) -> None:
+    """Write the model file atomically (temporary file, then rename)."""
+    from hwpts.io.atomic import write_text_atomic
+
+    write_text_atomic(path, dumps_model(model))
+
+
+def _reject_constant(token):
+    raise ValueError(f"non-finite number {token} in a model file")
+
+
+def load_model(path: str | os.PathLike):
+    """Read and validate a model file; return a fitted :class:`~hwpts.identification.PWARX`."""
+    p = Path(path)
+    if not p.exists():
+        raise DataError(f"model {str(p)!r}: no such file")
+    if p.is_dir():
+        raise DataError(f"model {str(p)!r}: is a folder, expected a .json model file")
+    try:
+        text = p.read_text(encoding="utf-8")
+        doc = json.loads(text, parse_constant=_reject_constant)
+    except UnicodeDecodeError:
+        raise DataError(f"model {str(p)!r}: not a UTF-8 JSON file") from None
+    except ValueError as error:
+        raise DataError(f"model {str(p)!r}: not a valid JSON model file ({error})") from None
+    try:
+        return model_from_dict(doc)
+    except HwptsError as error:
+        raise DataError(f"model {str(p)!r}: {error}") from None
+
+
+def _require(doc, key, kind, where):
+    if not isinstance(doc, dict) or key not in doc:
+        raise DataError(f"missing key {key!r} in {where}")
+    value = doc[key]
+    if kind is not None and not isinstance(value, kind):
+        raise DataError(f"{where}.{key} must be {getattr(kind, '__name__', kind)}, got {type(value).__name__}")
+    return value
+
+
+def _numbers(value, shape_desc: str, where: str) -> np.ndarray:
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise DataError(f"{where} must be numbers ({shape_desc})") from None
+    if not np.all(np.isfinite(arr)):
+        raise DataError(f"{where} holds a non-finite number")
+    return arr
+
+
+def model_from_dict(doc: dict):
+    """Validate a model document and build the estimator (see module doc for what is checked)."""
+    from hwpts.identification.partition import RegionPartition
+    from hwpts.identification.pwarx import PWARX
+    from hwpts.identification.regressors import RegressorStructure
+
+    if not isinstance(doc, dict):
+        raise DataError("a model file must hold a JSON object")
+    schema = doc.get("schema")
+    if schema != SCHEMA:
+        raise DataError(f"schema {schema!r} is not {SCHEMA!r}; this is not an hwpts PWARX model file")
+    for key in (*CHECKED_SECTIONS, "checksum"):
+        _require(doc, key, None, "the model")
+    cs = _require(doc, "checksum", dict, "the model")
+    value = _require(cs, "value", str, "checksum")
+    try:
+        expected = checksum(doc)
+    except ValueError:
+        raise DataError("the model holds a non-finite number") from None
+    if value != expected:
+        raise DataError(
+            "checksum mismatch: the numbers in the file were changed after it was saved "
+            "(or it is corrupt); refit the model with 'hwpts identify'"
+        )
+    st_doc = _require(doc, "structure", dict, "the model")
+    for key in ("na", "nb", "nk", "constant", "input_names", "output_name"):
+        _require(st_doc, key, None, "structure")
+    try:
+        structure = RegressorStructure.from_dict(st_doc)
+    except HwptsError as error:
+        raise DataError(f"structure: {error}") from None
+    nf = structure.n_features
+    regions = _require(doc, "regions", list, "the model")
+    if not regions:
+        raise DataError("the model has no region")
+    theta, kinds = [], []
+    for i, reg in enumerate(regions):
+        th = _numbers(_require(reg, "theta", list, f"regions[{i}]"), f"{nf + 1} numbers", f"regions[{i}].theta")
+        if th.shape != (nf + 1,):
+            raise DataError(f"regions[{i}].theta has {th.size} numbers, expected {nf + 1} for {structure.describe_orders()}")
+        kind = _require(reg, "model", str, f"regions[{i}]")
+        if kind not in ("affine", "constant", "zero"):
+            raise DataError(f"regions[{i}].model is {kind!r}; expected affine, constant or zero")
+        theta.append(th)
+        kinds.append(kind)
+    part_doc = _require(doc, "partition", dict, "the model")
+    polys = _require(part_doc, "polyhedra", list, "partition")
+    if len(polys) != len(regions):
+        raise DataError(f"partition has {len(polys)} polyhedra for {len(regions)} regions")
+    H, g = [], []
+    for i, poly in enumerate(polys):
+        h = _numbers(_require(poly, "H", list, f"partition.polyhedra[{i}]"), "rows", f"partition.polyhedra[{i}].H")
+        gi = _numbers(_require(poly, "g", list, f"partition.polyhedra[{i}]"), "numbers", f"partition.polyhedra[{i}].g")
+        h = h.reshape(0, nf) if h.size == 0 else h
+        if h.ndim != 2 or h.shape[1] != nf:
+            raise DataError(f"partition.polyhedra[{i}].H must have {nf} columns, got shape {h.shape}")
+        if gi.shape != (h.shape[0],):
+            raise DataError(f"partition.polyhedra[{i}].g must have {h.shape[0]} numbers, got {gi.size}")
+        H.append(h)
+        g.append(gi)
+    partition = RegionPartition(H, g, kind=str(part_doc.get("kind", "polyhedra")))
+    training = _require(doc, "training", dict, "the model")
+    out_range = _numbers(_require(training, "output_range", list, "training"), "2 numbers", "training.output_range")
+    if out_range.shape != (2,) or out_range[0] > out_range[1]:
+        raise DataError("training.output_range must be [low, high]")
+    in_ranges = _numbers(_require(training, "input_ranges", list, "training"), "pairs", "training.input_ranges")
+    if in_ranges.shape != (structure.n_inputs, 2):
+        raise DataError(f"training.input_ranges must have {structure.n_inputs} [low, high] pairs")
+    seg = doc.get("segmentation") or {}
+    model = PWARX.from_parts(structure, partition, np.array(theta), kinds, out_range, in_ranges,
+                             segmentation_info=seg if isinstance(seg, dict) else {})
+    model.region_counts_ = np.array([int(r.get("n_train_samples", 0)) for r in regions], dtype=np.int64)
+    if isinstance(seg, dict) and isinstance(seg.get("method"), str):
+        model.segmentation = seg["method"]
+    return model
