@@ -75,8 +75,16 @@ def solve_region(X: np.ndarray, y: np.ndarray, constant: bool, ridge: float = 0.
             pen = pen[:-1]
         A = np.vstack([A, pen])
         b = np.concatenate([y, np.zeros(pen.shape[0])])
-    coef, _, rank, sv = np.linalg.lstsq(A, b, rcond=None)
-    cond = float(sv[0] / sv[-1]) if sv.size and sv[-1] > 0 else float("inf")
+    coef = None
+    if A.shape[0] >= 4 * A.shape[1]:  # tall: normal equations (fast), if well conditioned
+        G = A.T @ A
+        ev = np.linalg.eigvalsh(G)
+        cond = float(np.sqrt(ev[-1] / ev[0])) if ev[0] > 0 else float("inf")
+        if cond < 1e6:
+            coef = np.linalg.solve(G, A.T @ b)
+    if coef is None:  # SVD least squares: robust to rank deficiency
+        coef, _, rank, sv = np.linalg.lstsq(A, b, rcond=None)
+        cond = float(sv[0] / sv[-1]) if sv.size and sv[-1] > 0 else float("inf")
     coef = coef / scale
     theta = np.zeros(nf + 1)
     if constant:

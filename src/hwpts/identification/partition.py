@@ -136,11 +136,11 @@ def scores_to_partition(W: np.ndarray, b: np.ndarray, kind: str = "linear-classi
     return RegionPartition(H, g, kind=kind)
 
 
-def fit_linear_partition(X: np.ndarray, labels: np.ndarray, n_regions: int, C: float = 1e3,
+def fit_linear_partition(X: np.ndarray, labels: np.ndarray, n_regions: int, C: float = 1e4,
                          max_iter: int = 500) -> RegionPartition:
     """Multicategory linear classifier of regressors into regions, returned as polyhedra (eq. 9).
 
-    Multinomial logistic regression (scikit-learn, L-BFGS) on standardised regressors; the scores
+    Multinomial logistic regression (scikit-learn, Newton-Cholesky) on standardised regressors; the scores
     are mapped back to the raw coordinates so the polyhedra apply to ``x_k`` directly. Labels must
     be ``0 .. n_regions-1``; a label without samples gets an empty region (never chosen).
     """
@@ -161,10 +161,12 @@ def fit_linear_partition(X: np.ndarray, labels: np.ndarray, n_regions: int, C: f
     if present.size == 1:
         b[present[0]] = 0.0
     else:
-        clf = LogisticRegression(C=C, max_iter=max_iter, tol=1e-6)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # ConvergenceWarning on separable data is harmless here
-            clf.fit(Z, labels)
+            try:  # Newton-Cholesky: multinomial since scikit-learn 1.6, fast for few features
+                clf = LogisticRegression(C=C, solver="newton-cholesky", max_iter=100, tol=1e-8).fit(Z, labels)
+            except ValueError:  # older scikit-learn: L-BFGS
+                clf = LogisticRegression(C=C, max_iter=max_iter, tol=1e-8).fit(Z, labels)
         coef, icpt = clf.coef_, clf.intercept_
         if coef.shape[0] == 1:  # binary: score 0 for the first class, w'z + b for the second
             coef = np.vstack([np.zeros_like(coef), coef])

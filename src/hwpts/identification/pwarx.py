@@ -102,7 +102,7 @@ class PWARX(BaseEstimator):
 
     def __init__(self, output_order=1, input_order=1, input_delay=1, n_regions=2,
                  segmentation="clustering", hyperplanes=None, region_models=None, constant=True,
-                 ridge=0.0, refinement_rounds=3, classifier_C=1e3, segmentation_params=None,
+                 ridge=0.0, refinement_rounds=3, classifier_C=1e4, segmentation_params=None,
                  polish=False, random_state=None):
         self.output_order = output_order
         self.input_order = input_order

@@ -129,6 +129,28 @@ def system5(n=2000, sigma=0.05, rng=None):
     return SyntheticData(u, sim.output, sim.regions, 2, 2, 1, 3, SYSTEM5_THETA)
 
 
+def simulate_true_pwarx(structure, partition, theta, inputs, noise, initial_output):
+    """Equation-error PWARX data ``y_k = phi_k' theta_sigma(k) + e_k``: (output, modes).
+
+    A plain Python loop, independent of the compiled simulator, so tests can compare the two.
+    """
+    u = np.asarray(inputs, dtype=float)
+    if u.ndim == 1:
+        u = u[:, None]
+    n = u.shape[0]
+    m = structure.max_lag
+    y = np.zeros(n)
+    y[:m] = np.asarray(initial_output, dtype=float)[:m]
+    modes = np.full(n, -1)
+    sig, lag = structure.lags
+    for k in range(m, n):
+        x = np.array([y[k - lg] if s < 0 else u[k - lg, s] for s, lg in zip(sig, lag)])
+        r = int(partition.predict(x[None])[0])
+        y[k] = theta[r, :-1] @ x + theta[r, -1] + noise[k]
+        modes[k] = r
+    return y, modes
+
+
 SYSTEMS = {1: system1, 2: system2, 3: system3, 4: system4, 5: system5}
 
 

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hwpts.identification.segmentation.base import SegmentationResult, Segmenter, standardize
+from hwpts.identification.segmentation.base import SegmentationResult, Segmenter, kmeans_labels, standardize
 
 
 def _fit_thetas(Phi, ys, labels, s, ridge):
@@ -94,8 +94,6 @@ class AlternatingSegmenter(Segmenter):
         self.max_iter = max_iter
 
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
-        from sklearn.cluster import KMeans
-
         from hwpts.identification.segmentation.clustering import ClusteringSegmenter
 
         self._check_regions(n_regions, X.shape[0])
@@ -112,8 +110,7 @@ class AlternatingSegmenter(Segmenter):
             if r == 0:
                 init = ClusteringSegmenter(n_init=3).segment(X, y, s, structure, rng).labels
             else:
-                km = KMeans(n_clusters=s, n_init=1, random_state=int(rng.integers(2**31 - 1)))
-                init = km.fit_predict(np.column_stack([Z, ys])).astype(np.int64)
+                init = kmeans_labels(np.column_stack([Z, ys]), s, rng, n_init=1)
             labels, obj, it = alternate(Phi, ys, Z, init, s, self.gamma, self.max_iter)
             objectives.append(obj)
             if best is None or obj < best[1]:

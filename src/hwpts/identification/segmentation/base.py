@@ -68,3 +68,19 @@ def standardize(X: np.ndarray) -> np.ndarray:
     sd = X.std(axis=0)
     sd[sd == 0] = 1.0
     return (X - X.mean(axis=0)) / sd
+
+
+def kmeans_labels(F: np.ndarray, n_clusters: int, rng, n_init: int = 10, sample_weight=None,
+                  max_fit_samples: int = 4000) -> np.ndarray:
+    """k-means labels of the rows of ``F``; centres fitted on a random subset of at most
+    ``max_fit_samples`` rows (k-means cost grows with n, the centres do not need every row)."""
+    from sklearn.cluster import KMeans
+
+    n = F.shape[0]
+    idx = np.arange(n)
+    if n > max_fit_samples:
+        idx = np.sort(rng.choice(n, max_fit_samples, replace=False))
+    w = None if sample_weight is None else sample_weight[idx]
+    km = KMeans(n_clusters=n_clusters, n_init=n_init, random_state=int(rng.integers(2**31 - 1)))
+    km.fit(F[idx], sample_weight=w)
+    return km.predict(F).astype(np.int64)

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hwpts.identification.segmentation.base import SegmentationResult, Segmenter, standardize
+from hwpts.identification.segmentation.base import SegmentationResult, Segmenter, kmeans_labels, standardize
 
 
 def local_features(X, y, n_neighbors: int):
@@ -62,8 +62,6 @@ class ClusteringSegmenter(Segmenter):
         self.n_init = n_init
 
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
-        from sklearn.cluster import KMeans
-
         self._check_regions(n_regions, X.shape[0])
         p = X.shape[1] + 1
         c = self.n_neighbors if self.n_neighbors is not None else max(2 * p, p + 3)
@@ -80,6 +78,5 @@ class ClusteringSegmenter(Segmenter):
         F = (F - mu) / sd
         F[:, :p] /= np.sqrt(p)
         F[:, p:] /= np.sqrt(max(X.shape[1], 1))
-        km = KMeans(n_clusters=n_regions, n_init=self.n_init, random_state=int(rng.integers(2**31 - 1)))
-        labels = km.fit(F, sample_weight=w * len(w)).labels_.astype(np.int64)
+        labels = kmeans_labels(F, n_regions, rng, self.n_init, sample_weight=w * len(w))
         return SegmentationResult(labels, n_regions, info={"n_neighbors": int(c)})

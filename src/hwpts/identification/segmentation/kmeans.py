@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hwpts.identification.segmentation.base import SegmentationResult, Segmenter, standardize
+from hwpts.identification.segmentation.base import SegmentationResult, Segmenter, kmeans_labels, standardize
 
 
 class KMeansSegmenter(Segmenter):
@@ -20,11 +20,7 @@ class KMeansSegmenter(Segmenter):
         self.n_init = n_init
 
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
-        from sklearn.cluster import KMeans
-
         self._check_regions(n_regions, X.shape[0])
         Z = standardize(np.column_stack([X, y]) if self.include_output else X)
-        km = KMeans(n_clusters=n_regions, n_init=self.n_init,
-                    random_state=int(rng.integers(2**31 - 1)))
-        labels = km.fit_predict(Z).astype(np.int64)
-        return SegmentationResult(labels, n_regions, refine=False, info={"inertia": float(km.inertia_)})
+        labels = kmeans_labels(Z, n_regions, rng, self.n_init)
+        return SegmentationResult(labels, n_regions, refine=False)

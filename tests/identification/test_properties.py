@@ -1,0 +1,98 @@
+"""Property tests (hypothesis): recovery of noise-free PWARX, ARX equivalence, predict/simulate."""
+
+import warnings
+
+import numpy as np
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from hwpts.identification import PWARX, region_accuracy
+from hwpts.identification.partition import Hyperplane, hyperplane_partition
+from hwpts.identification.regressors import RegressorStructure
+from hwpts.identification.synthetic import simulate_true_pwarx
+
+SETTINGS = settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+
+
+@SETTINGS
+@given(na=st.integers(0, 3), nb=st.integers(1, 3), nk=st.integers(0, 2), n_inputs=st.integers(1, 2),
+       seed=st.integers(0, 2**16))
+def test_one_region_is_least_squares_arx(na, nb, nk, n_inputs, seed):
+    rng = np.random.default_rng(seed)
+    n = 200
+    u = rng.standard_normal((n, n_inputs))
+    y = rng.standard_normal(n)
+    model = PWARX(na, nb, nk, segmentation="average").fit(u, y)
+    structure = RegressorStructure.create(na, nb, nk, n_inputs)
+    X, t = structure.build(u, y)
+    expected, *_ = np.linalg.lstsq(np.hstack([X, np.ones((len(t), 1))]), t, rcond=None)
+    np.testing.assert_allclose(model.theta_[0], expected, rtol=1e-8, atol=1e-10)
+    assert model.n_regions_ == 1
+
+
+def _stable_theta(rng, n_features, na):
+    theta = rng.uniform(-1, 1, n_features + 1)
+    theta[:na] = rng.uniform(-0.4, 0.4, na) / max(na, 1)  # sum |a_i| < 0.4: stable
+    return theta
+
+
+@SETTINGS
+@given(seed=st.integers(0, 2**16), na=st.integers(0, 2), threshold=st.floats(-0.3, 0.3))
+def test_noise_free_pwarx_is_recovered(seed, na, threshold):
+    """Two modes split by an input threshold; noise-free data -> exact parameters and regions."""
+    rng = np.random.default_rng(seed)
+    structure = RegressorStructure.create(na, [2, 1], [1, 1], 2)
+    part = hyperplane_partition([Hyperplane([1.0], -threshold, ["u1"])], structure)
+    theta = np.array([_stable_theta(rng, structure.n_features, na) for _ in range(2)])
+    theta[1, -1] = theta[0, -1] + 2.0  # modes clearly different
+    u = rng.uniform(-1, 1, (600, 2))
+    y, modes = simulate_true_pwarx(structure, part, theta, u, np.zeros(600), np.zeros(structure.max_lag))
+    model = PWARX(na, [2, 1], 1, n_regions=2, segmentation="alternating", random_state=seed).fit(u, y)
+    ok = modes >= 0
+    est = model.predict_regions(u, y)[ok]
+    assert region_accuracy(modes[ok], est) >= 0.99
+    # parameters: match estimated region to the true one, compare
+    for i in range(2):
+        j = np.bincount(modes[ok][est == i], minlength=2).argmax()
+        np.testing.assert_allclose(model.theta_[i], theta[j], atol=1e-6)
+    # fresh data: the learned boundary is within the sampling gap of the true one
+    u_val = rng.uniform(-1, 1, (2000, 2))
+    y_val, m_val = simulate_true_pwarx(structure, part, theta, u_val, np.zeros(2000), np.zeros(structure.max_lag))
+    ok = m_val >= 0
+    assert region_accuracy(m_val[ok], model.predict_regions(u_val, y_val)[ok]) >= 0.98
+
+
+@SETTINGS
+@given(seed=st.integers(0, 2**16), na=st.integers(1, 3), nk=st.integers(0, 2))
+def test_predict_and_simulate_agree_for_the_true_model(seed, na, nk):
+    """With the true model and noise-free data, one-step prediction and free run equal the data."""
+    rng = np.random.default_rng(seed)
+    structure = RegressorStructure.create(na, 2, nk, 1)
+    part = hyperplane_partition([Hyperplane([1.0, -0.5], 0.1, ["y(k-1)", "u1"])], structure)
+    theta = np.array([_stable_theta(rng, structure.n_features, na) for _ in range(2)])
+    u = rng.uniform(-1, 1, (400, 1))
+    y0 = rng.uniform(-1, 1, structure.max_lag)
+    y, modes = simulate_true_pwarx(structure, part, theta, u, np.zeros(400), y0)
+    model = PWARX.from_parts(structure, part, theta, output_range=(y.min(), y.max()))
+    np.testing.assert_allclose(model.predict(u, y), y, atol=1e-10)
+    sim = model.simulate(u, y)
+    assert not sim.diverged
+    np.testing.assert_allclose(sim.output, y, atol=1e-9)
+    np.testing.assert_array_equal(sim.regions, modes)
+    np.testing.assert_array_equal(model.predict_regions(u, y), modes)
+
+
+def test_free_run_divergence_is_reported_not_scored():
+    structure = RegressorStructure.create(1, 1, 1, 1)
+    part = hyperplane_partition([Hyperplane([1.0], 0.0, ["u1"])], structure)
+    theta = np.array([[1.5, 1.0, 0.0], [1.5, -1.0, 0.0]])
+    model = PWARX.from_parts(structure, part, theta, output_range=(-1.0, 1.0))
+    u = np.random.default_rng(0).uniform(-1, 1, (200, 1))
+    sim = model.simulate(u, np.zeros(200))
+    assert sim.diverged and sim.diverged_at is not None and "left the band" in sim.reason
+    assert np.isnan(sim.output[-1])
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        score = model.score(u, np.linspace(-1, 1, 200))
+    assert np.isnan(score)
+    assert any("left the band" in str(w.message) for w in caught)
