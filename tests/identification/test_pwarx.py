@@ -1,0 +1,124 @@
+"""The PWARX estimator: scikit-learn contract, errors, warnings, system 5, speed, auto selection."""
+
+import time
+import warnings
+
+import numpy as np
+import pytest
+from sklearn.base import clone
+
+from hwpts.dataset import IODataset
+from hwpts.errors import DataError, ParameterError
+from hwpts.identification import PWARX, RegionWarning, fit_percent, region_accuracy
+from hwpts.identification.local_models import fit_local_models
+from hwpts.identification.synthetic import make_system
+
+
+def test_init_only_stores_and_clone_works():
+    m = PWARX(output_order=3, input_order=[1, 2], n_regions=4, segmentation="nope")
+    assert m.get_params()["segmentation"] == "nope"
+    assert clone(m).get_params() == m.get_params()
+    with pytest.raises(ParameterError, match="unknown segmentation 'nope'"):
+        m.fit(np.zeros((50, 2)) + np.arange(50)[:, None], np.arange(50.0))
+
+
+def test_unfitted_predict_raises():
+    with pytest.raises(Exception, match="not fitted"):
+        PWARX().predict(np.zeros((10, 1)), np.zeros(10))
+
+
+def test_accepts_an_iodataset():
+    d = make_system(5, rng=0, n=600)
+    ds = IODataset(np.arange(600.0), d.inputs, d.output, ("a", "b"), "out")
+    m = PWARX(2, 2, 1, n_regions=3, segmentation="alternating", random_state=0).fit(ds)
+    assert m.input_names_ == ("a", "b") and m.output_name_ == "out"
+    assert m.structure_.feature_names[0] == "out(k-1)"
+    assert np.isfinite(m.score(ds))
+
+
+def test_constant_input_and_output_are_data_errors():
+    rng = np.random.default_rng(0)
+    u = np.column_stack([rng.standard_normal(100), np.ones(100)])
+    with pytest.raises(DataError, match="input 'u2' is constant"):
+        PWARX(1, 1, 1, segmentation="average").fit(u, rng.standard_normal(100))
+    with pytest.raises(DataError, match="output 'y' is constant"):
+        PWARX(1, 1, 1, segmentation="average").fit(u[:, :1], np.ones(100))
+    with pytest.raises(DataError, match="non-finite"):
+        PWARX(1, 1, 1, segmentation="average").fit(u[:, :1], np.r_[np.nan, np.ones(99)])
+
+
+def test_too_few_samples_message():
+    with pytest.raises(DataError, match="na=5, nb=4, nk=0 needs at least 19 samples"):
+        PWARX(5, 4, 0, segmentation="average").fit(np.random.default_rng(0).standard_normal((7, 2)), np.arange(7.0))
+
+
+def test_region_warning_on_starved_region():
+    rng = np.random.default_rng(0)
+    X = rng.standard_normal((40, 3))
+    y = rng.standard_normal(40)
+    labels = np.r_[np.zeros(38, dtype=int), [1, 1]]
+    with pytest.warns(RegionWarning, match="region 2 has 2 samples for 4 parameters"):
+        fit_local_models(X, y, labels, 2)
+
+
+def test_zero_mode():
+    d = make_system(5, rng=0, n=800)
+    m = PWARX(2, 2, 1, segmentation="hyperplane", hyperplanes=["1,0.6@u1"],
+              region_models=["zero", "affine"]).fit(d.inputs, d.output)
+    assert np.all(m.theta_[0] == 0) and m.region_models_ == ("zero", "affine")
+
+
+def test_system5_n20000():
+    """BENCHMARKS.md system 5, N = 20,000, validated on 3,000 noise-free samples.
+
+    Region accuracy >= 98 % and median free-run fit >= 95 % over six validation sets. The free-run
+    fit of this discontinuous system is dominated by rare boundary crossings after tiny parameter
+    errors (one validation set gives 84.8 %); the reference is the *oracle* (least squares on the
+    true modes with the true partition), which itself ranges 93-99.7 % on the same sets.
+    """
+    d = make_system(5, rng=0, n=20000)
+    t0 = time.perf_counter()
+    m = PWARX(2, 2, 1, n_regions=3, segmentation="alternating", random_state=0).fit(d.inputs, d.output)
+    elapsed = time.perf_counter() - t0
+    fits, accs = [], []
+    for seed in range(100, 106):
+        v = make_system(5, rng=seed, n=3000, sigma=0.0)
+        fits.append(m.score(v.inputs, v.output))
+        accs.append(region_accuracy(v.modes[2:], m.predict_regions(v.inputs, v.output)[2:]))
+    from hwpts.identification.regressors import RegressorStructure
+    from hwpts.identification.synthetic import system5_partition
+
+    st = RegressorStructure.create(2, 2, 1, 2)
+    X, y = st.build(d.inputs, d.output)
+    oracle = PWARX.from_parts(st, system5_partition(), fit_local_models(X, y, d.modes[2:], 3).theta)
+    oracle_fits = [oracle.score(v.inputs, v.output) for v in
+                   (make_system(5, rng=s, n=3000, sigma=0.0) for s in range(100, 106))]
+    assert min(accs) >= 0.98, accs
+    assert np.median(fits) >= 95.0, fits
+    assert np.mean(fits) >= np.mean(oracle_fits) - 4.0, (fits, oracle_fits)
+    assert elapsed < 20  # typically ~1 s; generous for a loaded CI machine
+
+
+def test_simulation_speed_one_million_samples():
+    d = make_system(5, rng=0, n=5000)
+    m = PWARX(2, 2, 1, n_regions=3, segmentation="alternating", random_state=0).fit(d.inputs, d.output)
+    u = np.random.default_rng(1).uniform(-1, 1, (1_000_000, 2))
+    m.simulate(u[:100], np.zeros(100))  # compile / load the cache
+    t0 = time.perf_counter()
+    sim = m.simulate(u, np.zeros(1_000_000))
+    elapsed = time.perf_counter() - t0
+    assert not sim.diverged
+    assert elapsed < 5  # ~0.05 s measured; the 1 s target is checked by the benchmark
+
+
+def test_auto_rejects_divergence_and_reports_candidates():
+    d = make_system(5, rng=1, n=2000)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        m = PWARX(2, 2, 1, n_regions=3, segmentation="auto", random_state=0).fit(d.inputs, d.output)
+    assert m.selection_ and sum(bool(r.get("chosen")) for r in m.selection_) == 1
+    chosen = next(r for r in m.selection_ if r.get("chosen"))
+    assert chosen["rejected"] is None and chosen["segmentation"] in ("clustering", "alternating")
+    assert m.n_regions_ == 3
+    v = make_system(5, rng=5, n=3000, sigma=0.0)
+    assert fit_percent(v.output[2:], m.simulate(v.inputs, v.output).output[2:]) > 80
