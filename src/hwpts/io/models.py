@@ -131,7 +131,7 @@ def _numbers(value, shape_desc: str, where: str) -> np.ndarray:
     try:
         arr = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
-        raise DataError(f"{where} must be numbers ({shape_desc})") from None
+        raise DataError(f"{where} must be {shape_desc} of numbers (got ragged or non-numeric values)") from None
     if not np.all(np.isfinite(arr)):
         raise DataError(f"{where} holds a non-finite number")
     return arr
@@ -188,7 +188,7 @@ def model_from_dict(doc: dict):
         raise DataError(f"partition has {len(polys)} polyhedra for {len(regions)} regions")
     H, g = [], []
     for i, poly in enumerate(polys):
-        h = _numbers(_require(poly, "H", list, f"partition.polyhedra[{i}]"), "rows", f"partition.polyhedra[{i}].H")
+        h = _numbers(_require(poly, "H", list, f"partition.polyhedra[{i}]"), "equal-length rows", f"partition.polyhedra[{i}].H")
         gi = _numbers(_require(poly, "g", list, f"partition.polyhedra[{i}]"), "numbers", f"partition.polyhedra[{i}].g")
         h = h.reshape(0, nf) if h.size == 0 else h
         if h.ndim != 2 or h.shape[1] != nf:

@@ -1,0 +1,77 @@
+"""Model files: schema hwpts.pwarx/1, round trip, validation on load (DataError, clear message)."""
+
+import json
+
+import numpy as np
+import pytest
+
+from hwpts.errors import DataError
+from hwpts.identification import PWARX
+from hwpts.identification.synthetic import make_system
+from hwpts.io.models import SCHEMA, checksum, load_model, save_model
+
+
+@pytest.fixture(scope="module")
+def fitted():
+    d = make_system(5, rng=0, n=1500)
+    return PWARX(2, 2, 1, n_regions=3, segmentation="alternating", random_state=0).fit(d.inputs, d.output), d
+
+
+@pytest.fixture
+def model_file(tmp_path, fitted):
+    path = tmp_path / "m.json"
+    save_model(fitted[0], path)
+    return path
+
+
+def test_round_trip_same_predictions(model_file, fitted):
+    model, d = fitted
+    doc = json.loads(model_file.read_text())
+    assert doc["schema"] == SCHEMA
+    assert len(doc["partition"]["polyhedra"]) == 3
+    assert doc["structure"]["regressor_names"][0] == "y(k-1)"
+    loaded = load_model(model_file)
+    np.testing.assert_array_equal(loaded.theta_, model.theta_)
+    np.testing.assert_array_equal(loaded.simulate(d.inputs, d.output).output, model.simulate(d.inputs, d.output).output)
+    np.testing.assert_array_equal(loaded.predict_regions(d.inputs, d.output), model.predict_regions(d.inputs, d.output))
+
+
+def _edit(path, fn, fix_checksum=True):
+    doc = json.loads(path.read_text())
+    fn(doc)
+    if fix_checksum:
+        doc["checksum"]["value"] = checksum(doc)
+    path.write_text(json.dumps(doc))
+
+
+@pytest.mark.parametrize("edit, fix, match", [
+    (lambda d: d.update(schema="hwpts.reproduce/1"), False, "schema 'hwpts.reproduce/1' is not 'hwpts.pwarx/1'"),
+    (lambda d: d["regions"][0]["theta"].__setitem__(0, 0.123), False, "checksum mismatch"),
+    (lambda d: d.pop("partition"), False, "missing key 'partition'"),
+    (lambda d: d["regions"][1]["theta"].pop(), True, r"regions\[1\].theta has 6 numbers, expected 7"),
+    (lambda d: d["partition"]["polyhedra"][0]["H"][0].append(1.0), True, r"polyhedra\[0\].H must be equal-length rows"),
+    (lambda d: d["partition"]["polyhedra"][0].update(H=[[1.0] * 7, [1.0] * 7]), True, "must have 6 columns"),
+    (lambda d: d["partition"]["polyhedra"].pop(), True, "2 polyhedra for 3 regions"),
+    (lambda d: d["regions"][0].update(model="cubic"), True, "expected affine, constant or zero"),
+    (lambda d: d["training"].update(output_range=[1.0, 0.0]), True, r"output_range must be \[low, high\]"),
+])
+def test_bad_model_files(model_file, edit, fix, match):
+    _edit(model_file, edit, fix)
+    with pytest.raises(DataError, match=match):
+        load_model(model_file)
+
+
+def test_non_finite_number_refused(model_file):
+    text = model_file.read_text().replace('"theta": [', '"theta": [NaN, ', 1)
+    model_file.write_text(text)
+    with pytest.raises(DataError, match="non-finite"):
+        load_model(model_file)
+
+
+def test_not_json_and_missing(tmp_path):
+    bad = tmp_path / "x.json"
+    bad.write_text("{not json")
+    with pytest.raises(DataError, match="not a valid JSON model file"):
+        load_model(bad)
+    with pytest.raises(DataError, match="no such file"):
+        load_model(tmp_path / "absent.json")
