@@ -1,0 +1,187 @@
+"""``hwpts identify | validate | predict`` in-process: outputs, and one clear line on bad input."""
+
+import json
+
+import numpy as np
+import pytest
+from scipy.io import savemat
+
+from hwpts.cli import main
+from hwpts.identification.synthetic import make_system
+from hwpts.io.datasets import write_csv
+
+
+@pytest.fixture
+def data_csv(tmp_path):
+    d = make_system(5, rng=0, n=1500)
+    path = tmp_path / "s5.csv"
+    write_csv(path, {"time_s": np.arange(1500) * 0.01, "u1": d.inputs[:, 0], "u2": d.inputs[:, 1], "y": d.output})
+    return path
+
+
+IDENTIFY = ["--input", "u1", "--input", "u2", "--output", "y", "--na", "2", "--nb", "2"]
+
+
+@pytest.fixture
+def model_json(tmp_path, data_csv, capsys):
+    out = tmp_path / "m.json"
+    assert main(["identify", str(data_csv), *IDENTIFY, "--segmentation", "alternating", "--regions", "3",
+                 "--out", str(out)]) == 0
+    capsys.readouterr()
+    return out
+
+
+def test_identify_prints_summary_and_writes_model(tmp_path, data_csv, capsys):
+    out = tmp_path / "m.json"
+    code = main(["identify", str(data_csv), *IDENTIFY, "--segmentation", "alternating", "--regions", "3",
+                 "--seed", "1", "--out", str(out)])
+    summary = json.loads(capsys.readouterr().out)
+    assert code == 0 and out.exists()
+    assert summary["n_regions"] == 3 and summary["segmentation"] == "alternating"
+    assert summary["train_fit_percent"] > 50 and summary["train_one_step_fit_percent"] > 80
+    assert json.loads(out.read_text())["schema"] == "hwpts.pwarx/1"
+
+
+def test_validate_json_and_text(model_json, data_csv, capsys):
+    assert main(["validate", str(model_json), str(data_csv), "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    for key in ("fit_percent", "one_step_fit_percent", "rmse", "n_samples"):
+        assert key in result
+    assert result["n_samples"] == 1500 and result["diverged"] is False
+    assert main(["validate", str(model_json), str(data_csv), "--rows", "500:"]) == 0
+    text = capsys.readouterr().out
+    assert "free-run fit:" in text and "1000 samples" in text
+
+
+@pytest.mark.parametrize("mode", ["simulate", "one-step"])
+def test_predict_writes_csv(model_json, data_csv, tmp_path, capsys, mode):
+    out = tmp_path / "p.csv"
+    assert main(["predict", str(model_json), str(data_csv), "--out", str(out), "--mode", mode]) == 0
+    header = out.read_text().splitlines()[0]
+    assert header == "time_s,u1,u2,y,y_predicted,region"
+    assert len(out.read_text().splitlines()) == 1501
+
+
+def test_hyperplane_identify(tmp_path, data_csv, capsys):
+    out = tmp_path / "h.json"
+    assert main(["identify", str(data_csv), *IDENTIFY, "--hyperplane", "1,-1,-0.6@y(k-1),u2(k-1)",
+                 "--hyperplane", "1,-1,0.4@y(k-1),u2(k-1)", "--out", str(out)]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["segmentation"] == "hyperplane" and summary["n_regions"] == 3
+    assert summary["train_one_step_fit_percent"] > 90
+
+
+def _expect_error(capsys, argv, match, not_written=None):
+    code = main(argv)
+    err = capsys.readouterr().err
+    assert code == 2
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("hwpts: error:"), err
+    assert "Traceback" not in err
+    assert match in lines[0], lines[0]
+    if not_written is not None:
+        assert not not_written.exists()
+        assert not list(not_written.parent.glob(f".{not_written.name}*"))  # no temporary left
+
+
+def test_unknown_column(tmp_path, data_csv, capsys):
+    out = tmp_path / "m.json"
+    _expect_error(capsys, ["identify", str(data_csv), "--input", "nope", "--output", "y", "--na", "1", "--nb", "1",
+                           "--out", str(out)], "no column(s) ['nope']; available columns are", out)
+
+
+def test_too_few_samples(tmp_path, capsys):
+    path = tmp_path / "short.csv"
+    rng = np.random.default_rng(0)
+    write_csv(path, {"a": rng.random(7), "b": rng.random(7), "y": rng.random(7)})
+    out = tmp_path / "m.json"
+    _expect_error(capsys, ["identify", str(path), "--input", "a", "--input", "b", "--output", "y", "--na", "5",
+                           "--nb", "4", "--nk", "0", "--out", str(out)],
+                  "na=5, nb=4, nk=0 needs at least 19 samples (5 initial conditions + 14 parameters); "
+                  f"{path} has 7 rows", out)
+
+
+def test_nan_in_data(tmp_path, capsys):
+    path = tmp_path / "nan.csv"
+    path.write_text("u,y\n" + "\n".join(f"{i % 7},{i % 5}" for i in range(30)) + "\nnan,1\n")
+    out = tmp_path / "m.json"
+    _expect_error(capsys, ["identify", str(path), "--input", "u", "--output", "y", "--na", "1", "--nb", "1",
+                           "--out", str(out)], "non-finite value (NaN or inf) at row 30", out)
+
+
+def test_constant_input(tmp_path, capsys):
+    path = tmp_path / "c.csv"
+    rng = np.random.default_rng(0)
+    write_csv(path, {"u": np.ones(50), "v": rng.random(50), "y": rng.random(50)})
+    out = tmp_path / "m.json"
+    _expect_error(capsys, ["identify", str(path), "--input", "v", "--input", "u", "--output", "y", "--na", "1",
+                           "--nb", "1", "--segmentation", "average", "--out", str(out)], "input 'u' is constant", out)
+
+
+def test_region_left_empty(tmp_path, data_csv, capsys):
+    out = tmp_path / "m.json"
+    _expect_error(capsys, ["identify", str(data_csv), *IDENTIFY, "--hyperplane", "1,5", "--out", str(out)],
+                  "leave region(s) [2] of 2 empty", out)
+
+
+def test_model_of_another_schema_and_tampered(tmp_path, model_json, data_csv, capsys):
+    doc = json.loads(model_json.read_text())
+    other = tmp_path / "other.json"
+    other.write_text(json.dumps({**doc, "schema": "hwpts.reproduce/1"}))
+    _expect_error(capsys, ["validate", str(other), str(data_csv)], "is not 'hwpts.pwarx/1'")
+    doc["regions"][0]["theta"][0] += 1e-9
+    tampered = tmp_path / "tampered.json"
+    tampered.write_text(json.dumps(doc))
+    out = tmp_path / "p.csv"
+    _expect_error(capsys, ["predict", str(tampered), str(data_csv), "--out", str(out)], "checksum mismatch", out)
+
+
+def test_mat_without_the_variable(tmp_path, capsys):
+    path = tmp_path / "d.mat"
+    rng = np.random.default_rng(0)
+    savemat(path, {"u": rng.random((40, 1)), "p": rng.random((40, 1))})
+    out = tmp_path / "m.json"
+    _expect_error(capsys, ["identify", str(path), "--input", "u", "--output", "y", "--na", "1", "--nb", "1",
+                           "--out", str(out)], "no column(s) ['y']; available columns are ['p', 'u']", out)
+
+
+def test_mat_with_the_variables_works(tmp_path, capsys):
+    path = tmp_path / "d.mat"
+    d = make_system(5, rng=2, n=400)
+    savemat(path, {"u1": d.inputs[:, :1], "u2": d.inputs[:, 1:], "y": d.output[:, None]})
+    out = tmp_path / "m.json"
+    assert main(["identify", str(path), *IDENTIFY, "--segmentation", "average", "--out", str(out)]) == 0
+    assert json.loads(capsys.readouterr().out)["n_regions"] == 1
+
+
+def test_bad_arguments(tmp_path, data_csv, capsys):
+    out = tmp_path / "m.json"
+    _expect_error(capsys, ["identify", str(data_csv), *IDENTIFY, "--segmentation", "nope", "--out", str(out)],
+                  "invalid choice: 'nope'", out)
+    _expect_error(capsys, ["identify", str(data_csv), *IDENTIFY, "--hyperplane", "a,b", "--out", str(out)],
+                  "hyperplane 'a,b': expected numbers", out)
+    _expect_error(capsys, ["identify", str(data_csv), *IDENTIFY, "--time", "t", "--out", str(out)],
+                  "no time column 't'", out)
+    _expect_error(capsys, ["identify", str(data_csv), *IDENTIFY, "--regions", "x", "--out", str(out)],
+                  "--regions expects an int", out)
+
+
+def test_diverging_free_run_writes_no_file(tmp_path, data_csv, capsys):
+    from hwpts.identification import PWARX
+    from hwpts.identification.partition import RegionPartition
+    from hwpts.identification.regressors import RegressorStructure
+    from hwpts.io.models import save_model
+
+    st = RegressorStructure.create(2, 2, 1, 2, input_names=["u1", "u2"], output_name="y")
+    theta = np.zeros((1, 7))
+    theta[0, 0] = 1.5
+    theta[0, 2] = 1.0
+    model = PWARX.from_parts(st, RegionPartition.single(6), theta, output_range=(-2.0, 2.0),
+                             input_ranges=[[-1, 1], [-1, 1]])
+    path = tmp_path / "unstable.json"
+    save_model(model, path)
+    assert main(["validate", str(path), str(data_csv), "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert result["diverged"] is True and result["fit_percent"] is None and "left the band" in result["reason"]
+    out = tmp_path / "p.csv"
+    _expect_error(capsys, ["predict", str(path), str(data_csv), "--out", str(out)], "no file written", out)
