@@ -82,21 +82,14 @@ def steady_state_command(args) -> int:
 
 
 def sweep_command(args) -> int:
+    from hwpts.experiments.sweeps import sweep_columns
     from hwpts.io.datasets import write_csv
     from hwpts.plant import PlantParameters, sweep
 
     voltages = np.linspace(*args.voltages)
     pumps = np.linspace(*args.pump_speeds)
     result = sweep(PlantParameters.paper(), voltages, pumps)
-    vv, ww = np.meshgrid(voltages, pumps, indexing="ij")
-    n = vv.size
-    surfaces = (("up", result.up_rpm), ("down", result.down_rpm), ("average", result.average_rpm))
-    write_csv(args.out, {
-        "valve_voltage_v": np.tile(vv.ravel(), 3),
-        "pump_speed_rpm": np.tile(ww.ravel(), 3),
-        "direction": np.repeat([name for name, _ in surfaces], n),
-        "motor_a_speed_rpm": np.concatenate([s.ravel() for _, s in surfaces]),
-    })
+    write_csv(args.out, sweep_columns(result))
     print(
         f"wrote {args.out}: {result.points_per_sweep} points per sweep (up, down, average); "
         f"largest hysteresis gap {np.max(np.abs(result.gap_percent)):.1f} % of full scale"

@@ -1,0 +1,1 @@
+"""The paper's experiments on the simulated test bed: sweeps, validation cases, the full pipeline."""

@@ -1,0 +1,55 @@
+"""Output folders written as a whole: a run fills a staging folder that replaces the target at the
+end, so a failed run leaves an earlier complete one intact and two runs never mix their files."""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import shutil
+import tempfile
+from pathlib import Path
+
+from hwpts.errors import DataError
+
+
+def check_replaceable(path: str | os.PathLike, schema: str, marker: str = "summary.json") -> None:
+    """Refuse a target that exists and is not empty, unless it is an earlier run of ``schema``."""
+    out = Path(path)
+    if not out.exists():
+        return
+    if not out.is_dir():
+        raise DataError(f"--out {str(out)!r}: exists and is a file, expected a folder")
+    if not any(out.iterdir()):
+        return
+    try:
+        found = json.loads((out / marker).read_text(encoding="utf-8")).get("schema")
+    except (OSError, ValueError, AttributeError):
+        found = None
+    if found != schema:
+        raise DataError(
+            f"--out {str(out)!r}: the folder exists and holds files that are not an earlier hwpts run "
+            f"(no {marker} with schema {schema!r}); choose another folder or empty it"
+        )
+
+
+@contextlib.contextmanager
+def staged_folder(path: str | os.PathLike, schema: str):
+    """Yield a fresh staging folder beside ``path``; on success it replaces ``path`` as a whole."""
+    out = Path(path)
+    check_replaceable(out, schema)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    stage = Path(tempfile.mkdtemp(prefix=f".{out.name}.new-", dir=out.parent))
+    try:
+        yield stage
+    except BaseException:
+        shutil.rmtree(stage, ignore_errors=True)
+        raise
+    old = None
+    if out.exists():
+        old = Path(tempfile.mkdtemp(prefix=f".{out.name}.old-", dir=out.parent))
+        os.rmdir(old)
+        os.replace(out, old)
+    os.replace(stage, out)
+    if old is not None:
+        shutil.rmtree(old, ignore_errors=True)
