@@ -64,3 +64,13 @@ def test_up_and_down_sweeps_differ_by_tens_of_percent_fig4():
     gap = result.gap_percent
     assert 20.0 <= gap.max() <= 40.0  # paper Fig. 4: up to ~30 % of full scale
     assert gap.min() >= -1e-6
+
+
+def test_fracture_line_found_in_the_data_is_close_to_eq16():
+    # section V.B: the fracture of the averaged surface (Fig. 5, Fig. 7) projects to eq. (16)
+    from hwpts.experiments.sweeps import find_fracture, record_sweeps
+
+    f = find_fracture(record_sweeps(progress=False))
+    pumps = np.linspace(200, 1000, 9)
+    assert np.max(np.abs(f.voltage_at(pumps) - (1755.2 - pumps) / 486.41)) < 0.1
+    assert f.slope == pytest.approx(-486.41, rel=0.1)
