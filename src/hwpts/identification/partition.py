@@ -137,12 +137,13 @@ def scores_to_partition(W: np.ndarray, b: np.ndarray, kind: str = "linear-classi
 
 
 def fit_linear_partition(X: np.ndarray, labels: np.ndarray, n_regions: int, C: float = 1e4,
-                         max_iter: int = 500) -> RegionPartition:
+                         max_iter: int = 500, columns=None) -> RegionPartition:
     """Multicategory linear classifier of regressors into regions, returned as polyhedra (eq. 9).
 
     Multinomial logistic regression (scikit-learn, Newton-Cholesky) on standardised regressors; the scores
     are mapped back to the raw coordinates so the polyhedra apply to ``x_k`` directly. Labels must
     be ``0 .. n_regions-1``; a label without samples gets an empty region (never chosen).
+    ``columns`` (indices) restricts the classifier to some regressors (the others get zero weight).
     """
     from sklearn.linear_model import LogisticRegression
 
@@ -152,6 +153,14 @@ def fit_linear_partition(X: np.ndarray, labels: np.ndarray, n_regions: int, C: f
     nf = X.shape[1]
     if n_regions == 1:
         return RegionPartition.single(nf)
+    if columns is not None:
+        cols = np.asarray(columns, dtype=np.int64)
+        sub = fit_linear_partition(X[:, cols], labels, n_regions, C, max_iter)
+        W = np.zeros((n_regions, nf))
+        W[:, cols] = sub.scores[0]
+        partition = scores_to_partition(W, sub.scores[1])
+        partition.scores = (W, sub.scores[1])
+        return partition
     mean = X.mean(axis=0)
     sd = X.std(axis=0)
     sd[sd == 0] = 1.0

@@ -75,6 +75,10 @@ class PWARX(BaseEstimator):
         Inverse regularisation of the multinomial logistic region classifier.
     segmentation_params : dict, optional
         Keyword parameters of the segmentation method.
+    partition_columns : sequence of str, optional
+        Regressor columns (names like ``"y(k-1)"`` or input names) the region classifier may use;
+        default all. Fewer columns: fewer boundary parameters, better generalisation when the
+        switching is known to depend on a few signals (e.g. the output level).
     polish : bool
         Refine the local parameters by minimising the free-run simulation error on the training
         data (partition fixed; see :mod:`hwpts.identification.polish`), kept only if better.
@@ -103,7 +107,7 @@ class PWARX(BaseEstimator):
     def __init__(self, output_order=1, input_order=1, input_delay=1, n_regions=2,
                  segmentation="clustering", hyperplanes=None, region_models=None, constant=True,
                  ridge=0.0, refinement_rounds=3, classifier_C=1e4, segmentation_params=None,
-                 polish=False, random_state=None):
+                 polish=False, partition_columns=None, random_state=None):
         self.output_order = output_order
         self.input_order = input_order
         self.input_delay = input_delay
@@ -117,6 +121,7 @@ class PWARX(BaseEstimator):
         self.classifier_C = classifier_C
         self.segmentation_params = segmentation_params
         self.polish = polish
+        self.partition_columns = partition_columns
         self.random_state = random_state
 
     # ------------------------------------------------------------------ fitting
@@ -176,6 +181,9 @@ class PWARX(BaseEstimator):
             return self
 
         X_reg, target = structure.build(u, yy)
+        self._pcols = None
+        if self.partition_columns is not None:
+            self._pcols = sorted({structure.column_index(c) for c in self.partition_columns})
         n_regions = self.n_regions
         if segmenter.uses_n_regions:
             if not isinstance(n_regions, (int, np.integer)) or isinstance(n_regions, bool) or n_regions < 1:
@@ -236,7 +244,7 @@ class PWARX(BaseEstimator):
         boundary carry no information about where it lies, so they are left to the classifier.
         """
         labels = np.asarray(labels, dtype=np.int64)
-        partition = fit_linear_partition(X, labels, s, C=self.classifier_C)
+        partition = fit_linear_partition(X, labels, s, C=self.classifier_C, columns=self._pcols)
         labels = partition.predict(X)
         rounds = self.refinement_rounds if (refine and s > 1) else 0
         p = X.shape[1] + 1
@@ -256,14 +264,14 @@ class PWARX(BaseEstimator):
             confident = (order[:, 1] - order[:, 0]) > CONFIDENCE_MARGIN
             if np.bincount(proposal[confident], minlength=s).min() < p:
                 confident[:] = True
-            partition = fit_linear_partition(X[confident], proposal[confident], s, C=self.classifier_C)
+            partition = fit_linear_partition(X[confident], proposal[confident], s, C=self.classifier_C, columns=self._pcols)
             new_labels = partition.predict(X)
             if np.array_equal(new_labels, labels):
                 break
             labels = new_labels
         labels2, s2 = self._drop_empty(labels, s)
         if s2 != s:
-            partition = fit_linear_partition(X, labels2, s2, C=self.classifier_C)
+            partition = fit_linear_partition(X, labels2, s2, C=self.classifier_C, columns=self._pcols)
             labels2 = partition.predict(X)
         return labels2, partition
 
