@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: install reproduce test bench clean
+.PHONY: install reproduce test bench readme clean
 
 install: $(STAMP)
 
@@ -22,6 +22,9 @@ test: install
 
 bench: install
 	$(BIN)/python -m benchmarks
+
+readme: reproduce
+	$(BIN)/python tools/update_readme.py results
 
 clean:
 	rm -rf $(VENV) results .pytest_cache .hypothesis
