@@ -1,0 +1,222 @@
+"""Identification benchmark: accuracy and speed of the PWARX library, side by side with peers.
+
+``python -m benchmarks identification [--quick] [--no-peers]``
+
+Measured in the same run (BENCHMARKS.md):
+- systems 1-3: region accuracy (median of 5 data sets, 3,000 noise-free validation samples);
+- system 5 at N = 2,000 and 20,000: fit time, free-run fit and region accuracy on 3,000 noise-free
+  validation samples, for hwpts, a single least-squares ARX (the floor) and PyPARC (in its own
+  virtual environment ``benchmarks/.venv-pyparc``, created on demand; skipped with the reason if
+  that fails);
+- free-run simulation of 10^6 samples;
+- real data (when ``../shared/data`` or ``$HWPTS_DATA_DIR`` exists): pick_and_place and the
+  hydraulic actuator, everything selected on the training part only.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+PYPARC_VENV = HERE / ".venv-pyparc"
+PYPARC_PACKAGES = ["pycddlib<3", "pypoman<1.1", "scikit-learn<1.8", "pyparc"]
+
+
+def _pyparc_python() -> tuple[Path | None, str | None]:
+    """The PyPARC interpreter, creating the venv on demand; (None, reason) if impossible."""
+    py = PYPARC_VENV / "bin" / "python"
+    check = [str(py), "-c", "import pyparc.parc"]
+    if py.exists() and subprocess.run(check, capture_output=True).returncode == 0:
+        return py, None
+    print(f"creating {PYPARC_VENV.name} and installing {' '.join(PYPARC_PACKAGES)} ...", flush=True)
+    try:
+        subprocess.run([sys.executable, "-m", "venv", str(PYPARC_VENV)], check=True, capture_output=True)
+        proc = subprocess.run([str(py), "-m", "pip", "install", "--quiet", *PYPARC_PACKAGES],
+                              capture_output=True, text=True, timeout=1800)
+    except (subprocess.SubprocessError, OSError) as error:
+        return None, f"could not create the PyPARC environment: {error}"
+    if proc.returncode != 0:
+        tail = (proc.stderr or proc.stdout).strip().splitlines()[-3:]
+        return None, "pip install failed: " + " | ".join(tail)
+    probe = subprocess.run(check, capture_output=True, text=True)
+    if probe.returncode != 0:
+        return None, "pyparc installed but does not import: " + probe.stderr.strip().splitlines()[-1]
+    return py, None
+
+
+def _run_pyparc(py, X, y, u_val, y_val, K=3, sigma=1.0):
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "data.npz"
+        np.savez(path, X_train=X, y_train=y, u_val=u_val, y_val=y_val)
+        proc = subprocess.run([str(py), str(HERE / "peers" / "pyparc_runner.py"), str(path), str(K), str(sigma)],
+                              capture_output=True, text=True, timeout=3600)
+    if proc.returncode != 0:
+        raise RuntimeError(proc.stderr.strip().splitlines()[-1] if proc.stderr.strip() else "failed")
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+def _fmt(v, spec=".2f"):
+    return "-" if v is None or (isinstance(v, float) and not np.isfinite(v)) else format(v, spec)
+
+
+def bench_small_systems(rows):
+    from hwpts.identification import PWARX, region_accuracy
+    from hwpts.identification.synthetic import make_system
+
+    for number in (1, 2, 3):
+        accs = []
+        for seed in range(5):
+            d = make_system(number, rng=seed)
+            v = make_system(number, rng=1000 + seed, sigma=0.0, n=3000)
+            m = PWARX(d.na, d.nb, d.nk, n_regions=d.n_modes, segmentation="alternating", random_state=seed)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                m.fit(d.inputs, d.output)
+            ok = v.modes >= 0
+            accs.append(region_accuracy(v.modes[ok], m.predict_regions(v.inputs, v.output)[ok]))
+        rows.append((f"system {number}", f"region accuracy median {100 * np.median(accs):.1f} % "
+                     f"(min {100 * min(accs):.1f} %) over 5 data sets"))
+
+
+def bench_system5(n, pyparc, lines, seed=0):
+    from hwpts.identification import PWARX, region_accuracy
+    from hwpts.identification.metrics import best_permutation
+    from hwpts.identification.regressors import RegressorStructure
+    from hwpts.identification.synthetic import make_system
+
+    d = make_system(5, rng=seed, n=n)
+    v = make_system(5, rng=100 + seed, n=3000, sigma=0.0)
+    out = {}
+    for name, params in (("hwpts alternating", dict(n_regions=3, segmentation="alternating")),
+                         ("single LS ARX", dict(segmentation="average"))):
+        t0 = time.perf_counter()
+        m = PWARX(2, 2, 1, random_state=seed, **params).fit(d.inputs, d.output)
+        ft = time.perf_counter() - t0
+        sim = m.simulate(v.inputs, v.output)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            fit = m.score(v.inputs, v.output)
+        acc = region_accuracy(v.modes[2:], m.predict_regions(v.inputs, v.output)[2:]) if m.n_regions_ > 1 else None
+        out[name] = {"fit_time_s": ft, "fit_percent": None if sim.diverged else fit, "region_accuracy": acc}
+    if pyparc[0] is not None:
+        st = RegressorStructure.create(2, 2, 1, 2)
+        X, y = st.build(d.inputs, d.output)
+        try:
+            r = _run_pyparc(pyparc[0], X, y, v.inputs, v.output)
+            modes = np.asarray(r["modes"])
+            ok = modes >= 0
+            acc = region_accuracy(v.modes[2:][ok], modes[ok]) if ok.all() else None
+            out["PyPARC (K=3, sigma=1)"] = {"fit_time_s": r["fit_time_s"], "fit_percent": r["fit_percent"],
+                                           "region_accuracy": acc}
+        except Exception as error:  # report and continue: the peer is optional
+            lines.append(f"PyPARC at N={n} failed: {error}")
+    return out
+
+
+def bench_simulation(lines):
+    from hwpts.identification import PWARX
+    from hwpts.identification.synthetic import make_system
+
+    d = make_system(5, rng=0, n=5000)
+    m = PWARX(2, 2, 1, n_regions=3, segmentation="alternating", random_state=0).fit(d.inputs, d.output)
+    u = np.random.default_rng(1).uniform(-1, 1, (1_000_000, 2))
+    m.simulate(u[:100], np.zeros(100))
+    times = []
+    for _ in range(3):
+        t0 = time.perf_counter()
+        sim = m.simulate(u, np.zeros(1_000_000))
+        times.append(time.perf_counter() - t0)
+    assert not sim.diverged
+    return min(times)
+
+
+def bench_real(lines):
+    from hwpts.identification import PWARX
+    from hwpts.identification.selection import expand_grid, select_model
+    from hwpts.io.datasets import read_table
+
+    root = Path(os.environ.get("HWPTS_DATA_DIR", HERE.parent.parent / "shared" / "data"))
+    pp = root / "pick_and_place" / "pick_and_place_400Hz.csv"
+    if pp.exists():
+        c = read_table(pp)
+        u, y = c["u"][:, None], c["y"]
+        utr, ytr, ute, yte = u[:5000], y[:5000], u[-1001:], y[-1001:]
+        arx = PWARX(2, 2, 1, segmentation="average").fit(utr, ytr).score(ute, yte)
+        grid = []
+        for na, nb in [(2, 2), (3, 2), (3, 3), (4, 4)]:
+            grid += expand_grid({"output_order": [na], "input_order": [nb], "segmentation": ["alternating"],
+                                 "n_regions": [2, 3, 4], "partition_columns": [None, ["y(k-1)"]], "polish": [True]})
+        t0 = time.perf_counter()
+        model, table = select_model(utr, ytr, grid, {"input_delay": 1, "random_state": 0}, n_folds=3, holdout=0.2)
+        chosen = next(r["params"] for r in table if r.get("chosen"))
+        lines.append(f"pick_and_place: test free-run fit {model.score(ute, yte):.2f} % (plain ARX {arx:.2f} %), "
+                     f"chosen on training only {chosen} from {len(table)} candidates in {time.perf_counter() - t0:.0f} s")
+    else:
+        lines.append(f"pick_and_place: skipped, {pp} not found")
+    act = root / "hydraulic_actuator" / "actuator.csv"
+    if act.exists():
+        c = read_table(act)
+        u, y = c["u_valve_opening"][:, None], c["y_oil_pressure"]
+        utr, ytr, ute, yte = u[:512], y[:512], u[512:], y[512:]
+        arx = PWARX(3, 2, 1, segmentation="average").fit(utr, ytr).score(ute, yte)
+        grid = []
+        for na, nb in [(3, 2), (3, 3)]:
+            grid += expand_grid({"output_order": [na], "input_order": [nb],
+                                 "segmentation": ["average", "kmeans", "clustering", "alternating"],
+                                 "n_regions": [2, 3], "polish": [False, True]})
+        model, table = select_model(utr, ytr, grid, {"input_delay": 1, "random_state": 0})
+        chosen = next(r["params"] for r in table if r.get("chosen"))
+        rejected = sum(r["rejected"] is not None for r in table)
+        lines.append(f"hydraulic_actuator: test free-run fit {model.score(ute, yte):.2f} % (plain ARX {arx:.2f} %), "
+                     f"chosen {chosen}; {rejected} of {len(table)} candidates rejected (diverged)")
+    else:
+        lines.append(f"hydraulic_actuator: skipped, {act} not found")
+
+
+def main(argv=None) -> int:
+    argv = list(argv or [])
+    quick = "--quick" in argv
+    peers = "--no-peers" not in argv
+    lines: list[str] = []
+    pyparc = (None, "disabled by --no-peers")
+    if peers:
+        pyparc = _pyparc_python()
+        if pyparc[0] is None:
+            print(f"PyPARC unavailable: {pyparc[1]}; continuing without it", flush=True)
+    small: list = []
+    bench_small_systems(small)
+    print("\nSynthetic systems 1-3 (BENCHMARKS.md), method alternating:")
+    for name, text in small:
+        print(f"  {name}: {text}")
+    sizes = (2000,) if quick else (2000, 20000)
+    for n in sizes:
+        res = bench_system5(n, pyparc, lines)
+        base = res["hwpts alternating"]["fit_time_s"]
+        print(f"\nSystem 5, N = {n:,} (validation: 3,000 noise-free samples)")
+        print(f"  {'method':24s} {'fit time [s]':>12s} {'time / hwpts':>12s} {'free-run fit %':>15s} {'region acc %':>13s}")
+        for name, r in res.items():
+            acc = None if r["region_accuracy"] is None else 100 * r["region_accuracy"]
+            print(f"  {name:24s} {r['fit_time_s']:12.3f} {r['fit_time_s'] / base:12.1f} "
+                  f"{_fmt(r['fit_percent']):>15s} {_fmt(acc):>13s}")
+    t_sim = bench_simulation(lines)
+    print(f"\nFree-run simulation of 10^6 samples (3 regions, na=nb=2, 2 inputs): {t_sim:.3f} s "
+          f"({'within' if t_sim < 1 else 'ABOVE'} the 1 s target)")
+    if not quick:
+        print("\nReal data (selection on the training part only):", flush=True)
+        bench_real(lines)
+    for line in lines:
+        print(f"  {line}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
