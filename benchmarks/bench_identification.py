@@ -192,6 +192,13 @@ def main(argv=None) -> int:
         pyparc = _pyparc_python()
         if pyparc[0] is None:
             print(f"PyPARC unavailable: {pyparc[1]}; continuing without it", flush=True)
+    # warm-up: imports, numba cache, scikit-learn code paths (not part of any timing)
+    from hwpts.identification import PWARX
+    from hwpts.identification.synthetic import make_system
+
+    d = make_system(5, rng=9, n=500)
+    PWARX(2, 2, 1, n_regions=3, segmentation="alternating", random_state=0).fit(d.inputs, d.output).simulate(
+        d.inputs, d.output)
     small: list = []
     bench_small_systems(small)
     print("\nSynthetic systems 1-3 (BENCHMARKS.md), method alternating:")
