@@ -65,7 +65,7 @@ class ReproduceConfig:
 
     seed: int = 0
     quick: bool = False
-    identification_duration_s: float = 600.0
+    identification_duration_s: float = 1200.0
     logger_sample_time_s: float = 0.01
     noise_std_rpm: float = 2.0
     """Speed sensors' noise on the test bed [r/min]."""
