@@ -66,44 +66,6 @@ _FLOW_SCALE = 1e-4  # m^3/s, typical flow: the reported residual is divided by i
 
 
 @numba.njit(cache=True)
-def solve_linear_inplace(a, b):
-    """Solve a x = b by Gaussian elimination with partial pivoting; b is overwritten by x.
-
-    Returns False when the matrix is singular. Small dense systems (5 x 5, 6 x 6) only.
-    """
-    n = b.shape[0]
-    for k in range(n):
-        piv = k
-        big = abs(a[k, k])
-        for i in range(k + 1, n):
-            if abs(a[i, k]) > big:
-                big = abs(a[i, k])
-                piv = i
-        if big == 0.0 or not math.isfinite(big):
-            return False
-        if piv != k:
-            for j in range(n):
-                tmp = a[k, j]
-                a[k, j] = a[piv, j]
-                a[piv, j] = tmp
-            tmp = b[k]
-            b[k] = b[piv]
-            b[piv] = tmp
-        for i in range(k + 1, n):
-            f = a[i, k] / a[k, k]
-            if f != 0.0:
-                for j in range(k, n):
-                    a[i, j] -= f * a[k, j]
-                b[i] -= f * b[k]
-    for i in range(n - 1, -1, -1):
-        s = b[i]
-        for j in range(i + 1, n):
-            s -= a[i, j] * b[j]
-        b[i] = s / a[i, i]
-    return True
-
-
-@numba.njit(cache=True)
 def _branch(w, pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu, out):
     """Flow balance g of one motor branch at shaft speed w and supply pressure pp (g falls with w).
 
