@@ -38,6 +38,7 @@ __all__ = ["PWARX", "FreeRunDivergedWarning"]
 DIVERGENCE_FACTOR = 50.0
 TRIM = 3.0  # outlier threshold (robust std) of the local least squares of learned partitions
 CONFIDENCE_MARGIN = 4.0  # cost margin for a sample to train the region classifier
+CLASSIFIER_ROWS = 6000  # most rows used to refit the region classifier in a refinement round
 
 
 class FreeRunDivergedWarning(UserWarning):
@@ -248,6 +249,7 @@ class PWARX(BaseEstimator):
         labels = partition.predict(X)
         rounds = self.refinement_rounds if (refine and s > 1) else 0
         p = X.shape[1] + 1
+        rng_sub = np.random.default_rng(self.random_state)
         for _ in range(rounds):
             labels, s = self._drop_empty(labels, s)
             if s == 1:
@@ -264,6 +266,7 @@ class PWARX(BaseEstimator):
             confident = (order[:, 1] - order[:, 0]) > CONFIDENCE_MARGIN
             if np.bincount(proposal[confident], minlength=s).min() < p:
                 confident[:] = True
+            confident = self._informative(confident, logp, rng_sub)
             partition = fit_linear_partition(X[confident], proposal[confident], s, C=self.classifier_C, columns=self._pcols)
             new_labels = partition.predict(X)
             if np.array_equal(new_labels, labels):
@@ -274,6 +277,25 @@ class PWARX(BaseEstimator):
             partition = fit_linear_partition(X, labels2, s2, C=self.classifier_C, columns=self._pcols)
             labels2 = partition.predict(X)
         return labels2, partition
+
+    @staticmethod
+    def _informative(mask, logp, rng, limit: int = CLASSIFIER_ROWS):
+        """At most ``limit`` rows of ``mask`` for the classifier: the half nearest the current
+        boundaries (smallest gap between the two largest class scores) and a random half of the
+        rest. Far-away rows hardly move a near-separable logistic boundary."""
+        idx = np.flatnonzero(mask)
+        if idx.size <= limit or logp is None:
+            return mask
+        top2 = np.sort(logp[idx], axis=1)[:, -2:]
+        gap = top2[:, 1] - top2[:, 0]
+        order = np.argsort(gap)
+        near = idx[order[: limit // 2]]
+        rest = idx[order[limit // 2:]]
+        far = rng.choice(rest, limit - near.size, replace=False)
+        out = np.zeros_like(mask)
+        out[near] = True
+        out[far] = True
+        return out
 
     @staticmethod
     def _drop_empty(labels, s):

@@ -14,7 +14,8 @@ assignment, alternate
    same value (equal parameters on disjoint regions),
 
 until the assignment is stable. Several restarts (the first from the Ferrari-Trecate clustering,
-the others from k-means of ``[z, y]`` with different seeds) keep the best objective. A region
+the others from k-means of ``[z, y]`` with different seeds) keep the best objective; on large data
+the restarts run on a random subset of 4,000 rows and only the best is carried to all rows. A region
 that loses almost all samples is re-seeded with the worst-fitted samples. Everything is vectorised.
 """
 
@@ -73,6 +74,9 @@ def alternate(Phi, ys, Z, labels, s, gamma=1.0, max_iter=50, ridge=1e-8):
     return labels, objective, it
 
 
+SUBSET = 4000  # rows used by the clustering start on large data sets
+
+
 class AlternatingSegmenter(Segmenter):
     """Alternating assignment/least squares with a separability term and restarts (module doc).
 
@@ -93,17 +97,10 @@ class AlternatingSegmenter(Segmenter):
         self.gamma = gamma
         self.max_iter = max_iter
 
-    def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
+    def _restarts(self, X, y, Z, ys, Phi, s, structure, rng):
+        """All starts on (X, y); the best (labels, objective, iterations, restart, objectives)."""
         from hwpts.identification.segmentation.clustering import ClusteringSegmenter
 
-        self._check_regions(n_regions, X.shape[0])
-        s = n_regions
-        n = X.shape[0]
-        if s == 1:
-            return SegmentationResult(np.zeros(n, dtype=np.int64), 1)
-        Z = standardize(X)
-        ys = (y - y.mean()) / (y.std() or 1.0)
-        Phi = np.hstack([Z, np.ones((n, 1))])
         best = None
         objectives = []
         for r in range(max(1, self.n_restarts)):
@@ -115,6 +112,31 @@ class AlternatingSegmenter(Segmenter):
             objectives.append(obj)
             if best is None or obj < best[1]:
                 best = (labels, obj, it, r)
-        labels, obj, it, r = best
+        return (*best, objectives)
+
+    def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
+        self._check_regions(n_regions, X.shape[0])
+        s = n_regions
+        n = X.shape[0]
+        if s == 1:
+            return SegmentationResult(np.zeros(n, dtype=np.int64), 1)
+        Z = standardize(X)
+        ys = (y - y.mean()) / (y.std() or 1.0)
+        Phi = np.hstack([Z, np.ones((n, 1))])
+        if n <= SUBSET:
+            labels, obj, it, r, objectives = self._restarts(X, y, Z, ys, Phi, s, structure, rng)
+        else:
+            # large data: every start on a random subset, the best one extended to all rows by one
+            # assignment step, then alternated on all rows
+            idx = np.sort(rng.choice(n, SUBSET, replace=False))
+            sub, _, _, r, objectives = self._restarts(X[idx], y[idx], Z[idx], ys[idx], Phi[idx], s,
+                                                       structure, rng)
+            theta = _fit_thetas(Phi[idx], ys[idx], sub, s, 1e-8)
+            R = (ys[:, None] - Phi @ theta.T) ** 2
+            sigma2 = float(np.mean(R[idx, sub])) + 1e-12
+            cent = np.array([Z[idx][sub == i].mean(axis=0) if np.any(sub == i) else Z[0] for i in range(s)])
+            D = ((Z[:, None, :] - cent[None]) ** 2).sum(axis=2) / max(Z.shape[1], 1)
+            init = np.argmin(R / sigma2 + self.gamma * D, axis=1)
+            labels, obj, it = alternate(Phi, ys, Z, init, s, self.gamma, self.max_iter)
         return SegmentationResult(labels, s, info={"objective": obj, "iterations": it, "restart": r,
                                                    "objectives": objectives})
