@@ -124,6 +124,7 @@ def cmd_identify(args) -> int:
         output_order=args.na, input_order=nb, input_delay=nk, n_regions=n_regions,
         segmentation=segmentation, hyperplanes=hyperplanes or None, region_models=region_models,
         ridge=args.ridge, polish=args.polish, random_state=args.seed,
+        partition_columns=args.partition_column or None,
     )
     t0 = time.perf_counter()
     with warnings.catch_warnings(record=True) as caught:
@@ -223,7 +224,7 @@ def _common_data_args(parser):
     parser.add_argument("--time", metavar="COL", default=None,
                         help="time column [s] (default: time_s if present, else the sample index)")
     parser.add_argument("--rows", metavar="START:STOP", default=None,
-                        help="use only these rows (Python slice, e.g. 0:5000 or -1001:)")
+                        help="use only these rows (Python slice: 0:5000; write --rows=-1001: for a negative start)")
 
 
 def register(subparsers):
@@ -249,6 +250,8 @@ def register(subparsers):
                         "regressor columns; repeat for a decision list (m hyperplanes, m+1 regions)")
     p.add_argument("--zero-region", type=int, action="append", default=[], metavar="I",
                    help="region I (1-based) is the zero mode y = 0 (paper eq. 18)")
+    p.add_argument("--partition-column", action="append", default=[], metavar="COL",
+                   help="regressor column the region classifier may use, e.g. 'y(k-1)' (repeat; default all)")
     p.add_argument("--ridge", type=float, default=0.0, help="ridge penalty of the local least squares")
     p.add_argument("--polish", action="store_true", help="refine parameters on the free-run simulation error")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
