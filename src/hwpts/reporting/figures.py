@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+import itertools
 
 import numpy as np
 
@@ -133,27 +134,32 @@ def fig7_fracture(result) -> bytes:
 
 
 def case_figure(result, case: str) -> bytes:
-    """Figs. 8-11: inputs of a case, then the measured motor A speed beside each model's free run."""
+    """Figs. 8-11: inputs of a case, then the measured motor A speed beside every model's free run."""
     plt = _pyplot()
     data = result.cases[case]
     t = data.time
-    fig, axes = plt.subplots(3, 1, figsize=(9, 7.5), sharex=True, gridspec_kw={"height_ratios": [1, 1, 2.2]})
+    fig, axes = plt.subplots(4, 1, figsize=(9, 10), sharex=True, gridspec_kw={"height_ratios": [1, 1, 2.2, 2.2]})
     axes[0].plot(t, data.extra["valve_voltage_v"], color="k", label="command")
     axes[0].plot(t, data.input("valve_voltage_play_v"), color="tab:purple", linestyle="--", label="compensated (play)")
     axes[0].set_ylabel("valve [V]")
     axes[0].legend(fontsize=8, loc="upper right")
     axes[1].plot(t, data.input("pump_speed_rpm"), color="k")
     axes[1].set_ylabel("pump, measured [r/min]")
-    axes[2].plot(t, data.output, color="k", linewidth=2.2, alpha=0.6, label="test bed (measured)")
-    for name in SHOWN_METHODS:
-        method = result.methods[name]
-        color, style = STYLES[name]
-        fit = method.fit_percent[case]
-        label = f"{name}: {'diverged' if np.isnan(fit) else f'{fit:.1f} %'}"
-        axes[2].plot(t, method.simulated[case], color=color, linestyle=style, linewidth=1.3, label=label)
-    axes[2].set_ylabel("motor A speed [r/min]")
-    axes[2].set_xlabel("time [s]")
-    axes[2].legend(fontsize=8, loc="best")
+    others = [name for name in result.methods if name not in SHOWN_METHODS]
+    palette = itertools.cycle(["tab:green", "tab:brown", "tab:pink", "tab:olive", "tab:cyan", "tab:purple"])
+    for ax, names in ((axes[2], SHOWN_METHODS), (axes[3], others)):
+        ax.plot(t, data.output, color="k", linewidth=2.2, alpha=0.6, label="test bed (measured)")
+        for name in names:
+            method = result.methods[name]
+            color, style = STYLES[name] if name in STYLES else (next(palette), "-")
+            fit = method.fit_percent[case]
+            label = f"{name}: {'diverged' if np.isnan(fit) else f'{fit:.1f} %'}"
+            ax.plot(t, method.simulated[case], color=color, linestyle=style, linewidth=1.3, label=label)
+        ax.set_ylabel("motor A speed [r/min]")
+        ax.legend(fontsize=8, loc="best")
+    axes[2].set_title("the paper's method, its variants and the package's best", fontsize=9)
+    axes[3].set_title("the paper's alternative segmentations and the library's learned partitions", fontsize=9)
+    axes[3].set_xlabel("time [s]")
     fig.suptitle(CASE_TITLES[case] + " (free-run fit %)")
     return _png(fig)
 
