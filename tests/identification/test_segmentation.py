@@ -19,7 +19,7 @@ from hwpts.identification.synthetic import make_system
 
 def test_registry_names_and_unknown_name_lists_them():
     assert set(SEGMENTATION_METHODS) == {"average", "zscore", "kmeans", "hyperplane", "clustering",
-                                         "alternating", "auto"}
+                                         "alternating", "threshold", "auto"}
     with pytest.raises(ParameterError, match=r"unknown segmentation 'nope'; valid methods are \['alternating'"):
         make_segmenter("nope")
 

@@ -8,6 +8,7 @@ The registry's keys are the names the CLI accepts (``hwpts identify --segmentati
 - ``hyperplane``: user-given hyperplanes, e.g. the paper's fracture line (eqs. 15-16);
 - ``clustering``: Ferrari-Trecate et al. (2003) clustering of local parameter vectors;
 - ``alternating``: alternating assignment / least squares with a separability term (k-LinReg, PARC);
+- ``threshold``: thresholds on one regressor column, e.g. ``y(k-1)``, by least squares (SETAR/TARX);
 - ``auto``: method and number of regions chosen by held-out free-run fit.
 """
 
@@ -21,6 +22,7 @@ from hwpts.identification.segmentation.base import SegmentationResult, Segmenter
 from hwpts.identification.segmentation.clustering import ClusteringSegmenter
 from hwpts.identification.segmentation.hyperplane import HyperplaneSegmenter
 from hwpts.identification.segmentation.kmeans import KMeansSegmenter
+from hwpts.identification.segmentation.threshold import ThresholdSegmenter
 from hwpts.identification.segmentation.zscore import ZScoreSegmenter
 
 SEGMENTATION_METHODS: dict[str, type[Segmenter]] = {
@@ -30,6 +32,7 @@ SEGMENTATION_METHODS: dict[str, type[Segmenter]] = {
     "hyperplane": HyperplaneSegmenter,
     "clustering": ClusteringSegmenter,
     "alternating": AlternatingSegmenter,
+    "threshold": ThresholdSegmenter,
     "auto": AutoSegmenter,
 }
 

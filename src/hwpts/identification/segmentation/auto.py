@@ -64,7 +64,8 @@ class AutoSegmenter(Segmenter):
             if not cls.uses_n_regions:
                 out.append((method, 2 if method == "zscore" else 1))
             else:
-                out.extend((method, s) for s in range(2, max_regions + 1))
+                top = min(max_regions, 3) if method == "threshold" else max_regions
+                out.extend((method, s) for s in range(2, top + 1))
         return out
 
     def select(self, estimator, inputs: np.ndarray, output: np.ndarray) -> tuple[dict, list[dict]]:
