@@ -38,7 +38,8 @@ from hwpts.experiments.sweeps import (
     find_fracture,
     record_sweeps,
 )
-from hwpts.identification import PWARX, fit_percent
+from hwpts.identification import PWARX, Hyperplane, fit_percent
+from hwpts.identification.segmentation.hyperplane import fracture_hyperplane
 from hwpts.plant import CASE_NAMES, PlantParameters, SweepResult, TestBed, identification_excitation, play_operator
 from hwpts.plant import validation_case as _case_profile
 
@@ -159,10 +160,11 @@ def compensate(dataset: IODataset, half_width: float) -> IODataset:
                      dataset.output_name, dict(dataset.extra, valve_voltage_v=v))
 
 
-def paper_hyperplanes(fracture: Fracture, valve_input: str) -> list[str]:
+def paper_hyperplanes(fracture: Fracture, valve_input: str) -> list[Hyperplane]:
     """The paper's partition as a decision list: hi >= 3.5 V, then the plateau side of eq. 16."""
-    cols = f"@{valve_input},pump_speed_rpm"
-    return [f"1,0,{-CLOSED_VOLTAGE:g}{cols}", fracture.hyperplane() + cols]
+    columns = [valve_input, "pump_speed_rpm"]
+    return [Hyperplane([1.0], -CLOSED_VOLTAGE, columns[:1]),
+            fracture_hyperplane(fracture.slope, fracture.intercept, columns)]
 
 
 def _method_specs(config: ReproduceConfig, fracture: Fracture, seed: int):

@@ -109,10 +109,6 @@ class Fracture:
         w = np.asarray(pump_speed_rpm, dtype=float)
         return np.where(v >= closed_voltage, 0, np.where(w >= self.slope * v + self.intercept, 1, 2))
 
-    def hyperplane(self) -> str:
-        """The half-plane above the line as ``"a,b,c"``: a*voltage + b*pump + c >= 0 (plateau side)."""
-        return f"{-self.slope:.6g},1,{-self.intercept:.6g}"
-
 
 def _hinge(v, y, resolution):
     """Kink voltage and plateau of y(v) ~ min(plateau, plateau - s (v - k)), least squares over k."""

@@ -88,6 +88,25 @@ def _branch(w, pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu,
 
 
 @numba.njit(cache=True)
+def _rtsafe_step(x, f, df, lo, hi, dx, dx_old):
+    """One step of rtsafe (Numerical Recipes) for a decreasing f bracketed by [lo, hi].
+
+    Narrows the bracket with the sign of f, then takes the Newton step, or bisects when Newton
+    leaves the bracket or does not halve the previous step. Returns (x, dx, dx_old, lo, hi).
+    """
+    if f > 0.0:
+        lo = x
+    else:
+        hi = x
+    newton = x - f / df if df < 0.0 else lo - 1.0
+    if not (lo < newton < hi) or abs(2.0 * f) > abs(dx_old * df):
+        dx_old = dx
+        dx = 0.5 * (hi - lo)
+        return lo + dx, dx, dx_old, lo, hi
+    return newton, newton - x, dx, lo, hi
+
+
+@numba.njit(cache=True)
 def _branch_speed(pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu, out, guess):
     """The unique shaft speed balancing a motor branch: safeguarded Newton on a bracket.
 
@@ -104,22 +123,7 @@ def _branch_speed(pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, k
     dx = dx_old
     for _ in range(200):
         _branch(w, pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu, out)
-        g = out[0]
-        dg = out[1]
-        if g > 0.0:
-            lo = w
-        else:
-            hi = w
-        newton = w - g / dg if dg < 0.0 else lo - 1.0
-        # rtsafe (Numerical Recipes): bisect when Newton leaves the bracket or does not halve the step
-        if not (lo < newton < hi) or abs(2.0 * g) > abs(dx_old * dg):
-            dx_old = dx
-            dx = 0.5 * (hi - lo)
-            w = lo + dx
-        else:
-            dx_old = dx
-            dx = newton - w
-            w = newton
+        w, dx, dx_old, lo, hi = _rtsafe_step(w, out[0], out[1], lo, hi, dx, dx_old)
         if abs(dx) <= 1e-12 * (1.0 + abs(w)):
             break
     _branch(w, pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu, out)
@@ -190,20 +194,7 @@ def _solve_points(spool, wp_cmd, p, out, iterations, residual, tol, max_iter):
         while it < max_iter:
             it += 1
             f = _pump_balance(pp, h, w, p, speeds, work)
-            df = work[0]
-            if f > 0.0:
-                lo = pp
-            else:
-                hi = pp
-            newton = pp - f / df if df < 0.0 else lo - 1.0
-            if not (lo < newton < hi) or abs(2.0 * f) > abs(dx_old * df):
-                dx_old = dx
-                dx = 0.5 * (hi - lo)
-                pp = lo + dx
-            else:
-                dx_old = dx
-                dx = newton - pp
-                pp = newton
+            pp, dx, dx_old, lo, hi = _rtsafe_step(pp, f, work[0], lo, hi, dx, dx_old)
             if abs(dx) <= tol * (1.0 + pp):
                 converged = True
                 break
