@@ -1,6 +1,5 @@
 """The PWARX estimator: scikit-learn contract, errors, warnings, system 5, speed, auto selection."""
 
-import time
 import warnings
 
 import numpy as np
@@ -77,9 +76,7 @@ def test_system5_n20000():
     true modes with the true partition), which itself ranges 93-99.7 % on the same sets.
     """
     d = make_system(5, rng=0, n=20000)
-    t0 = time.perf_counter()
     m = PWARX(2, 2, 1, n_regions=3, segmentation="alternating", random_state=0).fit(d.inputs, d.output)
-    elapsed = time.perf_counter() - t0
     fits, accs = [], []
     for seed in range(100, 106):
         v = make_system(5, rng=seed, n=3000, sigma=0.0)
@@ -96,19 +93,16 @@ def test_system5_n20000():
     assert min(accs) >= 0.98, accs
     assert np.median(fits) >= 95.0, fits
     assert np.mean(fits) >= np.mean(oracle_fits) - 4.0, (fits, oracle_fits)
-    assert elapsed < 20  # typically ~1 s; generous for a loaded CI machine
 
 
-def test_simulation_speed_one_million_samples():
+def test_free_run_of_one_million_samples_stays_bounded():
+    """A long free run (the 1 s speed target is measured by benchmarks/bench_identification.py)."""
     d = make_system(5, rng=0, n=5000)
     m = PWARX(2, 2, 1, n_regions=3, segmentation="alternating", random_state=0).fit(d.inputs, d.output)
     u = np.random.default_rng(1).uniform(-1, 1, (1_000_000, 2))
-    m.simulate(u[:100], np.zeros(100))  # compile / load the cache
-    t0 = time.perf_counter()
     sim = m.simulate(u, np.zeros(1_000_000))
-    elapsed = time.perf_counter() - t0
-    assert not sim.diverged
-    assert elapsed < 5  # ~0.05 s measured; the 1 s target is checked by the benchmark
+    assert not sim.diverged and np.all(np.isfinite(sim.output))
+    assert np.all(np.isin(sim.regions[2:], [0, 1, 2]))
 
 
 def test_auto_rejects_divergence_and_reports_candidates():

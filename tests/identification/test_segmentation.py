@@ -68,15 +68,31 @@ def _accuracy(number, method, seed):
     return region_accuracy(v.modes[ok], m.predict_regions(v.inputs, v.output)[ok])
 
 
-@pytest.mark.parametrize("number", [1, 2, 3])
+@pytest.mark.parametrize("number", [1, 2])
 def test_benchmark_systems_region_accuracy(number):
-    """BENCHMARKS.md systems 1-3 (N = 70, 100, 60, sigma = 0.1): >= 95 % on 3,000 fresh samples.
+    """BENCHMARKS.md systems 1-2 (N = 70, 100, sigma = 0.1): >= 95 % on 3,000 fresh samples.
 
-    Median over five data sets (seeds 0-4), each validated on noise-free data.
+    Every one of 20 data sets, each validated on noise-free data. (System 2 lost a mode on 3 of
+    20 data sets before the alternating method's continuation in gamma.)
     """
-    accs = [_accuracy(number, "alternating", seed) for seed in range(5)]
+    accs = [_accuracy(number, "alternating", seed) for seed in range(20)]
+    assert min(accs) >= 0.95, accs
+
+
+def test_system3_region_accuracy_at_the_data_limit():
+    """BENCHMARKS.md system 3 (the 'cake', 60 samples): median >= 95 % over 20 data sets, and on each
+    within two points of a linear classifier trained on the TRUE modes of the same 60 samples (with so
+    few samples the boundaries themselves are uncertain: that oracle ranges 92.8-99 %; hwpts equals it on 18 of 20 data sets, 1.3 points below on one)."""
+    from hwpts.identification.partition import fit_linear_partition
+
+    accs, oracle = [], []
+    for seed in range(20):
+        accs.append(_accuracy(3, "alternating", seed))
+        d = make_system(3, rng=seed)
+        v = make_system(3, rng=1000 + seed, sigma=0.0, n=3000)
+        oracle.append(region_accuracy(v.modes, fit_linear_partition(d.inputs, d.modes, 3).predict(v.inputs)))
     assert np.median(accs) >= 0.95, accs
-    assert min(accs) >= 0.92, accs
+    assert np.all(np.array(accs) >= np.array(oracle) - 0.02), (accs, oracle)
 
 
 def test_system1_equal_parameter_modes_kept_apart():
