@@ -1,13 +1,20 @@
 """``auto``: choose the segmentation method and the number of regions on the training data only.
 
-The training data are split into a head (default 75 %) and a held-out tail. Every candidate
-(``average`` with one region; each learned method with 2 .. ``max_regions`` regions) is fitted on
-the head and *simulated in free run* on the tail, from measured initial conditions. A candidate
-whose free run diverges, on the tail or over the whole training record, is rejected (a naive
-k-means PWARX diverges on the actuator data); among the rest, the best tail fit wins, and a
-candidate within ``tolerance`` percentage points of it is preferred when it has fewer regions or
-only stable modes (state-space poles inside the unit circle, eq. 7). The winner is refitted on all
-the training data.
+Every candidate (``average`` with one region; each learned method with 2 .. ``max_regions``
+regions) is scored by its *free-run* fit on held-out training data, simulated from measured initial
+conditions. Two schemes:
+
+- ``scheme="blocked"`` (default): blocked cross-validation for time series (Bergmeir & Benitez
+  2012), as :func:`hwpts.identification.selection.select_model`: the record is cut into
+  ``n_folds`` contiguous blocks, each simulated in free run by the candidate fitted on the others;
+  the score is the mean over blocks. Every regime of the record is validated.
+- ``scheme="tail"``: fitted on the head of the record and simulated on the last ``holdout`` share
+  (one block, cheaper; only the end of the record is validated).
+
+A candidate whose free run diverges on any block is rejected (a naive k-means PWARX diverges on
+the actuator data); among the rest, the best score wins, and a candidate within ``tolerance``
+percentage points of it is preferred when it has fewer regions or only stable modes (state-space
+poles inside the unit circle, eq. 7). The winner is refitted on all the training data.
 
 Candidates are independent: the search is a map over (method, n_regions) pairs.
 """
@@ -31,8 +38,12 @@ class AutoSegmenter(Segmenter):
         Candidate segmentation methods (registry names other than ``auto`` and ``hyperplane``).
     max_regions : int
         Largest number of regions tried (the estimator's ``n_regions`` when it is an int).
+    scheme : {"blocked", "tail"}
+        Blocked cross-validation over the whole record, or one held-out block at the end.
+    n_folds : int
+        Number of blocks of the ``blocked`` scheme (each needs at least 10 samples).
     holdout : float
-        Share of the training samples held out at the end for the free-run check.
+        Share of the training samples held out at the end (``tail`` scheme).
     tolerance : float
         Percentage points within which a simpler / stable candidate is preferred.
     """
@@ -40,10 +51,12 @@ class AutoSegmenter(Segmenter):
     name = "auto"
     uses_n_regions = False
 
-    def __init__(self, methods=DEFAULT_METHODS, max_regions: int = 4, holdout: float = 0.25,
-                 tolerance: float = 0.5):
+    def __init__(self, methods=DEFAULT_METHODS, max_regions: int = 4, scheme: str = "blocked",
+                 n_folds: int = 5, holdout: float = 0.25, tolerance: float = 0.5):
         self.methods = methods
         self.max_regions = max_regions
+        self.scheme = scheme
+        self.n_folds = n_folds
         self.holdout = holdout
         self.tolerance = tolerance
 
@@ -68,56 +81,65 @@ class AutoSegmenter(Segmenter):
                 out.extend((method, s) for s in range(2, top + 1))
         return out
 
+    def _blocks(self, n: int) -> list[tuple[int, int]]:
+        if self.scheme == "blocked":
+            k = self.n_folds
+            if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 2:
+                raise ParameterError(f"auto: n_folds must be an int >= 2, got {k!r}")
+            if n // k < 10:
+                raise ParameterError(f"auto: {n} training samples cannot make {k} blocks of >= 10 samples; "
+                                     f"use fewer folds or scheme='tail'")
+            edges = np.linspace(0, n, k + 1).round().astype(int)
+            return [(int(edges[i]), int(edges[i + 1])) for i in range(k)]
+        if self.scheme == "tail":
+            if not 0.05 <= self.holdout <= 0.5:
+                raise ParameterError(f"auto: holdout must be in [0.05, 0.5], got {self.holdout}")
+            return [(n - int(round(n * self.holdout)), n)]
+        raise ParameterError(f"auto: unknown scheme {self.scheme!r}; valid are ['blocked', 'tail']")
+
     def select(self, estimator, inputs: np.ndarray, output: np.ndarray) -> tuple[dict, list[dict]]:
         """Try every candidate; return (best parameters, table of every candidate)."""
-        from sklearn.base import clone
+        import warnings
 
-        from hwpts.identification.metrics import fit_percent
+        from hwpts.errors import HwptsError
+        from hwpts.identification.selection import _score_candidate
 
-        if not 0.05 <= self.holdout <= 0.5:
-            raise ParameterError(f"auto: holdout must be in [0.05, 0.5], got {self.holdout}")
         max_regions = self.max_regions
         if isinstance(estimator.n_regions, (int, np.integer)):
             max_regions = int(estimator.n_regions)
-        n = output.shape[0]
-        n_tail = int(round(n * self.holdout))
-        head = slice(0, n - n_tail)
-        tail = slice(n - n_tail, n)
+        blocks = self._blocks(output.shape[0])
+        scheme = "blocked" if self.scheme == "blocked" else "forward"
+        base = estimator.get_params()
         rows = []
         for method, s in self.candidates(max_regions):
-            params = {"segmentation": method, "n_regions": s}
-            cand = clone(estimator).set_params(**params)
-            row = {"segmentation": method, "n_regions": s, "tail_fit_percent": None,
-                   "train_fit_percent": None, "stable": None, "rejected": None}
+            params = {**base, "segmentation": method, "n_regions": s}
+            row = {"segmentation": method, "n_regions": s, "n_regions_fitted": None, "heldout_fit_percent": None,
+                   "block_fits_percent": None, "stable": None, "rejected": None}
             try:
-                import warnings
-
-                with warnings.catch_warnings():
-                    warnings.simplefilter("ignore")
-                    cand.fit(inputs[head], output[head])
-                    sim_tail = cand.simulate(inputs[tail], output[tail])
-                    sim_all = cand.simulate(inputs, output)
-            except IdentificationError as error:
-                row["rejected"] = f"fit failed: {error}"
-                rows.append(row)
-                continue
-            m = cand.structure_.max_lag
-            row["n_regions"] = int(cand.n_regions_)
-            row["stable"] = bool(all(ss.stable for ss in cand.state_space()))
-            if sim_tail.diverged or sim_all.diverged:
-                row["rejected"] = "free run diverged"
+                fits, reason = _score_candidate(params, inputs, output, blocks, scheme)
+                if fits is not None:  # stability of the model fitted on all the data
+                    full = estimator.__class__(**params)
+                    with warnings.catch_warnings():
+                        warnings.simplefilter("ignore")
+                        full.fit(inputs, output)
+                    row["n_regions_fitted"] = int(full.n_regions_)
+                    row["stable"] = bool(all(ss.stable for ss in full.state_space()))
+            except HwptsError as error:
+                fits, reason = None, f"fit failed: {error}"
+            if fits is None:
+                row["rejected"] = reason
             else:
-                row["tail_fit_percent"] = fit_percent(output[tail][m:], sim_tail.output[m:])
-                row["train_fit_percent"] = fit_percent(output[m:], sim_all.output[m:])
+                row["block_fits_percent"] = [round(f, 3) for f in fits]
+                row["heldout_fit_percent"] = float(np.mean(fits))
             rows.append(row)
         ok = [r for r in rows if r["rejected"] is None]
         if not ok:
             raise IdentificationError(
                 "auto: every candidate model diverged in free run or failed; try other orders"
             )
-        best_fit = max(r["tail_fit_percent"] for r in ok)
-        near = [r for r in ok if r["tail_fit_percent"] >= best_fit - self.tolerance]
-        near.sort(key=lambda r: (not r["stable"], r["n_regions"], -r["tail_fit_percent"]))
+        best_fit = max(r["heldout_fit_percent"] for r in ok)
+        near = [r for r in ok if r["heldout_fit_percent"] >= best_fit - self.tolerance]
+        near.sort(key=lambda r: (not r["stable"], r["n_regions_fitted"], -r["heldout_fit_percent"]))
         chosen = near[0]
         chosen["chosen"] = True
         return {"segmentation": chosen["segmentation"], "n_regions": chosen["n_regions"]}, rows
