@@ -59,23 +59,33 @@ def test_paper_partition_with_zero_mode():
     assert Hyperplane.parse("1,-3.5@hi").columns == ("hi",)
 
 
-def _accuracy(number, method, seed):
+def _accuracy(number, method, seed, **segmentation_params):
     d = make_system(number, rng=seed)
     v = make_system(number, rng=1000 + seed, sigma=0.0, n=3000)
-    m = PWARX(d.na, d.nb, d.nk, n_regions=d.n_modes, segmentation=method, random_state=seed)
+    m = PWARX(d.na, d.nb, d.nk, n_regions=d.n_modes, segmentation=method, random_state=seed,
+              segmentation_params=segmentation_params or None)
     m.fit(d.inputs, d.output)
     ok = v.modes >= 0
     return region_accuracy(v.modes[ok], m.predict_regions(v.inputs, v.output)[ok])
 
 
-@pytest.mark.parametrize("number", [1, 2])
+@pytest.mark.parametrize("number", [1, 2, 3])
 def test_benchmark_systems_region_accuracy(number):
-    """BENCHMARKS.md systems 1-2 (N = 70, 100, sigma = 0.1): >= 95 % on 3,000 fresh samples.
+    """BENCHMARKS.md systems 1-3 (N = 70, 100, 60, sigma = 0.1): >= 95 % on 3,000 fresh samples.
 
-    Every one of 20 data sets, each validated on noise-free data. (System 2 lost a mode on 3 of
-    20 data sets before the alternating method's continuation in gamma.)
+    Median over 20 data sets, each validated on noise-free data.
     """
     accs = [_accuracy(number, "alternating", seed) for seed in range(20)]
+    assert np.median(accs) >= 0.95, accs
+    if number == 1:  # the equal-parameter modes are kept apart on every data set
+        assert min(accs) >= 0.95, accs
+
+
+def test_system2_continuation_keeps_every_mode():
+    """System 2 (five modes, 100 samples): the plain alternation loses a mode on 3 of 20 data sets
+    (seeds 5, 8, 12: region accuracy 83, 82, 63 %); with the continuation in gamma every data set
+    is >= 95 %."""
+    accs = [_accuracy(2, "alternating", seed, anneal=(10.0, 3.0)) for seed in range(20)]
     assert min(accs) >= 0.95, accs
 
 
