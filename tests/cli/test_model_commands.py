@@ -40,6 +40,11 @@ def test_identify_prints_summary_and_writes_model(tmp_path, data_csv, capsys):
     assert summary["n_regions"] == 3 and summary["segmentation"] == "alternating"
     assert summary["train_fit_percent"] > 50 and summary["train_one_step_fit_percent"] > 80
     assert json.loads(out.read_text())["schema"] == "hwpts.pwarx/1"
+    # system 5 switches on y(k-1) - u2(k-1): the learned partition keeps those two columns
+    assert summary["partition_columns"] == ["y(k-1)", "u2(k-1)"]
+    assert main(["identify", str(data_csv), *IDENTIFY, "--segmentation", "alternating", "--regions", "3",
+                 "--seed", "1", "--all-partition-columns", "--out", str(out)]) == 0
+    assert "partition_columns" not in json.loads(capsys.readouterr().out)
 
 
 def test_validate_json_and_text(model_json, data_csv, capsys):

@@ -91,6 +91,10 @@ def test_system5_n20000():
     oracle_fits = [oracle.score(v.inputs, v.output) for v in
                    (make_system(5, rng=s, n=3000, sigma=0.0) for s in range(100, 106))]
     assert min(accs) >= 0.98, accs
+    # the learned boundaries use only the switching signal d = y(k-1) - u2(k-1)
+    assert m.segmentation_info_["partition_columns"] == ["y(k-1)", "u2(k-1)"]
+    H_other = np.vstack(m.partition_.H)[:, [1, 2, 3, 5]]
+    assert np.all(H_other == 0.0)
     assert np.median(fits) >= 95.0, fits
     assert np.mean(fits) >= np.mean(oracle_fits) - 4.0, (fits, oracle_fits)
 
@@ -116,3 +120,31 @@ def test_auto_rejects_divergence_and_reports_candidates():
     assert m.n_regions_ == 3
     v = make_system(5, rng=5, n=3000, sigma=0.0)
     assert fit_percent(v.output[2:], m.simulate(v.inputs, v.output).output[2:]) > 80
+
+
+def _static_switch(slope, n=4000, seed=0):
+    """Three inputs, y = x1 + 2 on {x1 + slope * x2 >= 0}, -x2 - 1 elsewhere; x3 is irrelevant."""
+    rng = np.random.default_rng(seed)
+    x = rng.uniform(-1, 1, (n, 3))
+    upper = x[:, 0] + slope * x[:, 1] >= 0
+    y = np.where(upper, x[:, 0] + 2.0, -x[:, 1] - 1.0) + 0.01 * rng.standard_normal(n)
+    return x, y, upper
+
+
+@pytest.mark.parametrize("slope, columns", [(0.0, ["u1(k)"]), (1.0, ["u1(k)", "u2(k)"]), (0.03, None)])
+def test_sparse_partition_keeps_the_columns_the_boundary_uses(slope, columns):
+    """The boundary x1 + slope * x2 = 0: with slope 0 only x1 is kept; with slope 1 both; with
+    slope 0.03 (x2's weight under the 5 % threshold, but dropping it misclassifies ~1 % of the
+    samples) the reduced classifier is refused and every column stays."""
+    x, y, upper = _static_switch(slope)
+    m = PWARX(0, [1, 1, 1], [0, 0, 0], n_regions=2, segmentation="alternating", random_state=0).fit(x, y)
+    assert m.segmentation_info_.get("partition_columns") == columns
+    xv, _, upper_v = _static_switch(slope, seed=1)
+    regions = m.predict_regions(xv, np.zeros(len(xv)))
+    assert region_accuracy(upper_v.astype(int), regions) >= 0.99
+    if columns is not None:
+        used = np.flatnonzero(np.any(np.vstack(m.partition_.H) != 0, axis=0))
+        assert [m.structure_.feature_names[c] for c in used] == columns
+    full = PWARX(0, [1, 1, 1], [0, 0, 0], n_regions=2, segmentation="alternating", random_state=0,
+                 sparse_partition=False).fit(x, y)
+    assert "partition_columns" not in full.segmentation_info_

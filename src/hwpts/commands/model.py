@@ -124,7 +124,7 @@ def cmd_identify(args) -> int:
         output_order=args.na, input_order=nb, input_delay=nk, n_regions=n_regions,
         segmentation=segmentation, hyperplanes=hyperplanes or None, region_models=region_models,
         ridge=args.ridge, polish=args.polish, random_state=args.seed,
-        partition_columns=args.partition_column or None,
+        partition_columns=args.partition_column or None, sparse_partition=not args.all_partition_columns,
     )
     t0 = time.perf_counter()
     with warnings.catch_warnings(record=True) as caught:
@@ -252,6 +252,9 @@ def register(subparsers):
                    help="region I (1-based) is the zero mode y = 0 (paper eq. 18)")
     p.add_argument("--partition-column", action="append", default=[], metavar="COL",
                    help="regressor column the region classifier may use, e.g. 'y(k-1)' (repeat; default all)")
+    p.add_argument("--all-partition-columns", action="store_true",
+                   help="keep every allowed column in a learned partition (default: drop the columns its "
+                        "boundaries hardly use)")
     p.add_argument("--ridge", type=float, default=0.0, help="ridge penalty of the local least squares")
     p.add_argument("--polish", action="store_true", help="refine parameters on the free-run simulation error")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")

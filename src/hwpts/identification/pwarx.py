@@ -39,6 +39,7 @@ DIVERGENCE_FACTOR = 50.0
 TRIM = 3.0  # outlier threshold (robust std) of the local least squares of learned partitions
 CONFIDENCE_MARGIN = 4.0  # cost margin for a sample to train the region classifier
 CLASSIFIER_ROWS = 6000  # most rows used to refit the region classifier in a refinement round
+SPARSE_TOL = 0.05  # a column whose boundary weight is below this share of the largest is dropped
 
 
 class FreeRunDivergedWarning(UserWarning):
@@ -80,6 +81,13 @@ class PWARX(BaseEstimator):
         Regressor columns (names like ``"y(k-1)"`` or input names) the region classifier may use;
         default all. Fewer columns: fewer boundary parameters, better generalisation when the
         switching is known to depend on a few signals (e.g. the output level).
+    sparse_partition : bool
+        After a learned partition is found, drop the regressor columns its boundaries hardly use
+        (standardised weight below 5 % of the largest in every boundary normal) and refit the
+        classifier on the rest, if it then classifies its training samples as well. Boundaries
+        that depend on a few signals (the paper's fracture line: valve voltage and pump speed) are
+        then estimated in that subspace, where the data are dense, instead of carrying noise in
+        every other direction.
     polish : bool
         Refine the local parameters by minimising the free-run simulation error on the training
         data (partition fixed; see :mod:`hwpts.identification.polish`), kept only if better.
@@ -108,7 +116,7 @@ class PWARX(BaseEstimator):
     def __init__(self, output_order=1, input_order=1, input_delay=1, n_regions=2,
                  segmentation="clustering", hyperplanes=None, region_models=None, constant=True,
                  ridge=0.0, refinement_rounds=3, classifier_C=1e4, segmentation_params=None,
-                 polish=False, partition_columns=None, random_state=None):
+                 polish=False, partition_columns=None, sparse_partition=True, random_state=None):
         self.output_order = output_order
         self.input_order = input_order
         self.input_delay = input_delay
@@ -123,6 +131,7 @@ class PWARX(BaseEstimator):
         self.segmentation_params = segmentation_params
         self.polish = polish
         self.partition_columns = partition_columns
+        self.sparse_partition = sparse_partition
         self.random_state = random_state
 
     # ------------------------------------------------------------------ fitting
@@ -183,6 +192,7 @@ class PWARX(BaseEstimator):
 
         X_reg, target = structure.build(u, yy)
         self._pcols = None
+        self._sparse_columns = None
         if self.partition_columns is not None:
             self._pcols = sorted({structure.column_index(c) for c in self.partition_columns})
         n_regions = self.n_regions
@@ -216,6 +226,9 @@ class PWARX(BaseEstimator):
         self.output_range_ = (float(yy.min()), float(yy.max()))
         self.input_ranges_ = np.column_stack([u.min(axis=0), u.max(axis=0)])
         self.segmentation_info_ = {"method": str(self.segmentation), **seg.info}
+        if self._sparse_columns is not None:
+            self.segmentation_info_["partition_columns"] = [structure.feature_names[c]
+                                                            for c in self._sparse_columns]
         if self.polish:
             from hwpts.identification.polish import polish_free_run
 
@@ -246,6 +259,7 @@ class PWARX(BaseEstimator):
         """
         labels = np.asarray(labels, dtype=np.int64)
         partition = fit_linear_partition(X, labels, s, C=self.classifier_C, columns=self._pcols)
+        train_X, train_labels = X, labels
         labels = partition.predict(X)
         rounds = self.refinement_rounds if (refine and s > 1) else 0
         p = X.shape[1] + 1
@@ -267,16 +281,52 @@ class PWARX(BaseEstimator):
             if np.bincount(proposal[confident], minlength=s).min() < p:
                 confident[:] = True
             confident = self._informative(confident, logp, rng_sub)
-            partition = fit_linear_partition(X[confident], proposal[confident], s, C=self.classifier_C, columns=self._pcols)
+            train_X, train_labels = X[confident], proposal[confident]
+            partition = fit_linear_partition(train_X, train_labels, s, C=self.classifier_C, columns=self._pcols)
             new_labels = partition.predict(X)
             if np.array_equal(new_labels, labels):
                 break
             labels = new_labels
+        if self.sparse_partition and s > 1 and partition.n_regions == s:
+            sparse = self._sparse_partition(train_X, train_labels, partition, s)
+            if sparse is not None:
+                partition = sparse
+                labels = partition.predict(X)
         labels2, s2 = self._drop_empty(labels, s)
         if s2 != s:
             partition = fit_linear_partition(X, labels2, s2, C=self.classifier_C, columns=self._pcols)
             labels2 = partition.predict(X)
         return labels2, partition
+
+    def _sparse_partition(self, X, labels, partition, s):
+        """The classifier refitted on the columns its boundaries use, or None (see ``sparse_partition``).
+
+        A column is used when its weight in some boundary normal ``w_i - w_j`` (standardised
+        coordinates) reaches ``SPARSE_TOL`` of that normal's largest weight. The reduced
+        classifier is kept only if it misclassifies no more of its training samples than the full
+        one, plus 0.1 %.
+        """
+        W, _ = partition.scores
+        sd = X.std(axis=0)
+        sd[sd == 0] = 1.0
+        used = np.zeros(X.shape[1], dtype=bool)
+        for i in range(s):
+            for j in range(i + 1, s):
+                normal = np.abs(W[i] - W[j]) * sd
+                if normal.max() > 0:
+                    used |= normal >= SPARSE_TOL * normal.max()
+        allowed = np.zeros(X.shape[1], dtype=bool)
+        allowed[self._pcols if self._pcols is not None else slice(None)] = True
+        used &= allowed
+        if not used.any() or used.sum() == allowed.sum():
+            return None
+        reduced = fit_linear_partition(X, labels, s, C=self.classifier_C, columns=np.flatnonzero(used))
+        errors_full = int(np.sum(partition.predict(X) != labels))
+        errors_reduced = int(np.sum(reduced.predict(X) != labels))
+        if errors_reduced > errors_full + max(1, int(0.001 * labels.size)):
+            return None
+        self._sparse_columns = np.flatnonzero(used)
+        return reduced
 
     @staticmethod
     def _informative(mask, logp, rng, limit: int = CLASSIFIER_ROWS):
@@ -404,6 +454,8 @@ class PWARX(BaseEstimator):
             "inputs": list(st.input_names), "output": st.output_name,
             "segmentation": self.segmentation_info_.get("auto", {}).get("segmentation", self.segmentation),
             "n_regions": int(self.n_regions_), "regions": regions,
+            **({"partition_columns": self.segmentation_info_["partition_columns"]}
+               if "partition_columns" in self.segmentation_info_ else {}),
         }
 
     @classmethod
