@@ -120,6 +120,21 @@ def test_auto_rejects_divergence_and_reports_candidates():
     assert m.n_regions_ == 3
     v = make_system(5, rng=5, n=3000, sigma=0.0)
     assert fit_percent(v.output[2:], m.simulate(v.inputs, v.output).output[2:]) > 80
+    # the chosen structure is also scored with the simulation-error polish, on the same blocks
+    polish_rows = [r for r in m.selection_ if r.get("polish")]
+    assert len(polish_rows) == 1 and polish_rows[0]["segmentation"] == chosen["segmentation"]
+    assert m.summary()["polished"] == bool(polish_rows[0].get("chosen"))
+
+
+def test_auto_parameters_are_its_own():
+    """segmentation_params of auto (here: no polish trial, one held-out block at the end) are not
+    passed on to the candidate methods (they used to make every candidate fail)."""
+    d = make_system(5, rng=1, n=600)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        m = PWARX(2, 2, 1, n_regions=2, segmentation="auto", random_state=0,
+                  segmentation_params={"try_polish": False, "scheme": "tail"}).fit(d.inputs, d.output)
+    assert not any(r.get("polish") for r in m.selection_) and m.summary()["polished"] is False
 
 
 def _static_switch(slope, n=4000, seed=0):

@@ -77,3 +77,16 @@ def test_naive_kmeans_on_actuator_is_reported_not_scored(real_data):
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 assert np.isnan(m.score(u[512:], y[512:]))
+
+
+def test_auto_on_actuator(real_data):
+    """What `hwpts identify` does by default (segmentation auto: method, regions and the polish
+    chosen by blocked cross-validation of the free-run fit on the training part)."""
+    cols = read_table(real_data("hydraulic_actuator", "actuator.csv"))
+    u, y = cols["u_valve_opening"][:, None], cols["y_oil_pressure"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = PWARX(3, 3, 1, n_regions="auto", segmentation="auto", random_state=0).fit(u[:512], y[:512])
+    fit = model.score(u[512:], y[512:])
+    print(f"actuator, auto: test fit {fit:.2f} % (plain ARX 39.9 %), {model.summary()}")
+    assert fit >= 60.0, (fit, [r for r in model.selection_ if r.get("chosen")])

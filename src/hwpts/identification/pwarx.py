@@ -456,6 +456,7 @@ class PWARX(BaseEstimator):
             "n_regions": int(self.n_regions_), "regions": regions,
             **({"partition_columns": self.segmentation_info_["partition_columns"]}
                if "partition_columns" in self.segmentation_info_ else {}),
+            "polished": bool(self.segmentation_info_.get("polish", {}).get("accepted", False)),
         }
 
     @classmethod

@@ -46,19 +46,23 @@ class AutoSegmenter(Segmenter):
         Share of the training samples held out at the end (``tail`` scheme).
     tolerance : float
         Percentage points within which a simpler / stable candidate is preferred.
+    try_polish : bool
+        Also score the chosen candidate with the simulation-error polish (``polish=True``) on the
+        same blocks, and keep the polish if it raises the held-out fit by more than ``tolerance``.
     """
 
     name = "auto"
     uses_n_regions = False
 
     def __init__(self, methods=DEFAULT_METHODS, max_regions: int = 4, scheme: str = "blocked",
-                 n_folds: int = 5, holdout: float = 0.25, tolerance: float = 0.5):
+                 n_folds: int = 5, holdout: float = 0.25, tolerance: float = 0.5, try_polish: bool = True):
         self.methods = methods
         self.max_regions = max_regions
         self.scheme = scheme
         self.n_folds = n_folds
         self.holdout = holdout
         self.tolerance = tolerance
+        self.try_polish = try_polish
 
     def segment(self, X, y, n_regions, structure, rng):  # pragma: no cover - used through PWARX
         raise IdentificationError("segmentation 'auto' selects whole models; use it through PWARX")
@@ -109,7 +113,8 @@ class AutoSegmenter(Segmenter):
             max_regions = int(estimator.n_regions)
         blocks = self._blocks(output.shape[0])
         scheme = "blocked" if self.scheme == "blocked" else "forward"
-        base = estimator.get_params()
+        # the candidates get their methods' defaults: segmentation_params are auto's own
+        base = {**estimator.get_params(), "segmentation_params": None}
         rows = []
         for method, s in self.candidates(max_regions):
             params = {**base, "segmentation": method, "n_regions": s}
@@ -141,5 +146,23 @@ class AutoSegmenter(Segmenter):
         near = [r for r in ok if r["heldout_fit_percent"] >= best_fit - self.tolerance]
         near.sort(key=lambda r: (not r["stable"], r["n_regions_fitted"], -r["heldout_fit_percent"]))
         chosen = near[0]
+        choice = {"segmentation": chosen["segmentation"], "n_regions": chosen["n_regions"],
+                  "segmentation_params": None}
+        if self.try_polish and not base.get("polish"):
+            row = {**{k: chosen[k] for k in ("segmentation", "n_regions")}, "polish": True,
+                   "heldout_fit_percent": None, "block_fits_percent": None, "rejected": None}
+            try:
+                fits, reason = _score_candidate({**base, **choice, "polish": True}, inputs, output, blocks, scheme)
+            except HwptsError as error:
+                fits, reason = None, f"fit failed: {error}"
+            if fits is None:
+                row["rejected"] = reason
+            else:
+                row["block_fits_percent"] = [round(f, 3) for f in fits]
+                row["heldout_fit_percent"] = float(np.mean(fits))
+                if row["heldout_fit_percent"] > chosen["heldout_fit_percent"] + self.tolerance:
+                    chosen = row
+                    choice["polish"] = True
+            rows.append(row)
         chosen["chosen"] = True
-        return {"segmentation": chosen["segmentation"], "n_regions": chosen["n_regions"]}, rows
+        return choice, rows
