@@ -47,36 +47,35 @@ SCHEMES = ("forward", "blocked")
 
 
 def _score_candidate(params, inputs, output, blocks, scheme="forward"):
+    """Free-run fit of ``params`` on each held-out block: (fits, None) or (None, why rejected)."""
     from hwpts.identification.pwarx import PWARX
 
     fits = []
-    for start, stop in blocks:
-        model = PWARX(**params)
-        if scheme == "blocked":
-            u_fit = np.concatenate([inputs[:start], inputs[stop:]])
-            y_fit = np.concatenate([output[:start], output[stop:]])
-        else:
-            u_fit, y_fit = inputs[:start], output[:start]
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            model.fit(u_fit, y_fit)
-            sim = model.simulate(inputs[start:stop], output[start:stop])
-        if sim.diverged:
-            return None, "free run diverged"
-        m = model.structure_.max_lag
-        fits.append(fit_percent(output[start + m:stop], sim.output[m:]))
+    try:
+        for start, stop in blocks:
+            model = PWARX(**params)
+            if scheme == "blocked":
+                u_fit = np.concatenate([inputs[:start], inputs[stop:]])
+                y_fit = np.concatenate([output[:start], output[stop:]])
+            else:
+                u_fit, y_fit = inputs[:start], output[:start]
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                model.fit(u_fit, y_fit)
+                sim = model.simulate(inputs[start:stop], output[start:stop])
+            if sim.diverged:
+                return None, "free run diverged"
+            m = model.structure_.max_lag
+            fits.append(fit_percent(output[start + m:stop], sim.output[m:]))
+    except HwptsError as error:
+        return None, f"fit failed: {error}"
     return fits, None
 
 
 def _row(cand, params, u, y, blocks, scheme):
     row = {"params": cand, "fits": None, "mean_fit_percent": None, "rejected": None}
-    try:
-        fits, reason = _score_candidate(params, u, y, blocks, scheme)
-    except HwptsError as error:
-        fits, reason = None, f"fit failed: {error}"
-    if fits is None:
-        row["rejected"] = reason
-    else:
+    fits, row["rejected"] = _score_candidate(params, u, y, blocks, scheme)
+    if fits is not None:
         row["fits"] = [round(f, 3) for f in fits]
         row["mean_fit_percent"] = float(np.mean(fits))
     return row

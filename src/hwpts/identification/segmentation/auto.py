@@ -115,27 +115,29 @@ class AutoSegmenter(Segmenter):
         scheme = "blocked" if self.scheme == "blocked" else "forward"
         # the candidates get their methods' defaults: segmentation_params are auto's own
         base = {**estimator.get_params(), "segmentation_params": None}
+
+        def scored(params, row):
+            fits, row["rejected"] = _score_candidate(params, inputs, output, blocks, scheme)
+            if fits is not None:
+                row["block_fits_percent"] = [round(f, 3) for f in fits]
+                row["heldout_fit_percent"] = float(np.mean(fits))
+            return row
+
         rows = []
         for method, s in self.candidates(max_regions):
             params = {**base, "segmentation": method, "n_regions": s}
-            row = {"segmentation": method, "n_regions": s, "n_regions_fitted": None, "heldout_fit_percent": None,
-                   "block_fits_percent": None, "stable": None, "rejected": None}
-            try:
-                fits, reason = _score_candidate(params, inputs, output, blocks, scheme)
-                if fits is not None:  # stability of the model fitted on all the data
-                    full = estimator.__class__(**params)
+            row = scored(params, {"segmentation": method, "n_regions": s, "n_regions_fitted": None,
+                                  "heldout_fit_percent": None, "block_fits_percent": None, "stable": None})
+            if row["rejected"] is None:  # stability of the model fitted on all the data
+                full = estimator.__class__(**params)
+                try:
                     with warnings.catch_warnings():
                         warnings.simplefilter("ignore")
                         full.fit(inputs, output)
                     row["n_regions_fitted"] = int(full.n_regions_)
                     row["stable"] = bool(all(ss.stable for ss in full.state_space()))
-            except HwptsError as error:
-                fits, reason = None, f"fit failed: {error}"
-            if fits is None:
-                row["rejected"] = reason
-            else:
-                row["block_fits_percent"] = [round(f, 3) for f in fits]
-                row["heldout_fit_percent"] = float(np.mean(fits))
+                except HwptsError as error:
+                    row["rejected"] = f"fit failed: {error}"
             rows.append(row)
         ok = [r for r in rows if r["rejected"] is None]
         if not ok:
@@ -149,20 +151,12 @@ class AutoSegmenter(Segmenter):
         choice = {"segmentation": chosen["segmentation"], "n_regions": chosen["n_regions"],
                   "segmentation_params": None}
         if self.try_polish and not base.get("polish"):
-            row = {**{k: chosen[k] for k in ("segmentation", "n_regions")}, "polish": True,
-                   "heldout_fit_percent": None, "block_fits_percent": None, "rejected": None}
-            try:
-                fits, reason = _score_candidate({**base, **choice, "polish": True}, inputs, output, blocks, scheme)
-            except HwptsError as error:
-                fits, reason = None, f"fit failed: {error}"
-            if fits is None:
-                row["rejected"] = reason
-            else:
-                row["block_fits_percent"] = [round(f, 3) for f in fits]
-                row["heldout_fit_percent"] = float(np.mean(fits))
-                if row["heldout_fit_percent"] > chosen["heldout_fit_percent"] + self.tolerance:
-                    chosen = row
-                    choice["polish"] = True
+            row = scored({**base, **choice, "polish": True},
+                         {"segmentation": chosen["segmentation"], "n_regions": chosen["n_regions"], "polish": True,
+                          "heldout_fit_percent": None, "block_fits_percent": None})
             rows.append(row)
+            if row["rejected"] is None and row["heldout_fit_percent"] > chosen["heldout_fit_percent"] + self.tolerance:
+                chosen = row
+                choice["polish"] = True
         chosen["chosen"] = True
         return choice, rows
