@@ -146,11 +146,13 @@ def _static_switch(slope, n=4000, seed=0):
     return x, y, upper
 
 
-@pytest.mark.parametrize("slope, columns", [(0.0, ["u1(k)"]), (1.0, ["u1(k)", "u2(k)"]), (0.03, None)])
+@pytest.mark.parametrize("slope, columns", [(0.0, ["u1(k)"]), (1.0, ["u1(k)", "u2(k)"]),
+                                           (0.03, ["u1(k)", "u2(k)"])])
 def test_sparse_partition_keeps_the_columns_the_boundary_uses(slope, columns):
-    """The boundary x1 + slope * x2 = 0: with slope 0 only x1 is kept; with slope 1 both; with
-    slope 0.03 (x2's weight under the 5 % threshold, but dropping it misclassifies ~1 % of the
-    samples) the reduced classifier is refused and every column stays."""
+    """The boundary x1 + slope * x2 = 0 (x3 unused): with slope 0 only x1 is kept; with slope 1
+    x1 and x2; with slope 0.03 x2's weight is under the 5 % threshold, but dropping it misclassifies
+    ~1 % of the samples, so that reduction is refused and the second tier (under 0.5 %) drops x3
+    alone."""
     x, y, upper = _static_switch(slope)
     m = PWARX(0, [1, 1, 1], [0, 0, 0], n_regions=2, segmentation="alternating", random_state=0).fit(x, y)
     assert m.segmentation_info_.get("partition_columns") == columns
@@ -163,3 +165,38 @@ def test_sparse_partition_keeps_the_columns_the_boundary_uses(slope, columns):
     full = PWARX(0, [1, 1, 1], [0, 0, 0], n_regions=2, segmentation="alternating", random_state=0,
                  sparse_partition=False).fit(x, y)
     assert "partition_columns" not in full.segmentation_info_
+
+
+def _used_columns(model):
+    used = np.flatnonzero(np.any(np.vstack(model.partition_.H) != 0, axis=0))
+    return [model.structure_.feature_names[c] for c in used]
+
+
+def test_sparse_columns_survive_a_dropped_region():
+    """A region left empty after the sparse step is dropped and the classifier refitted on the
+    sparse columns, which the summary reports."""
+    from hwpts.identification.segmentation.base import SegmentationResult, Segmenter
+
+    class Fixed(Segmenter):  # x1 < 0 versus x1 >= 0, and 3 stray samples in a third region
+        def segment(self, X, y, n_regions, structure, rng):
+            lab = (X[:, 0] < 0).astype(int)
+            lab[np.flatnonzero((X[:, 0] > 0.9) & (X[:, 2] > 0.6))[:3]] = 2
+            return SegmentationResult(lab, 3, refine=False)
+
+    x, y, _ = _static_switch(0.0, n=2000)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        m = PWARX(0, [1, 1, 1], [0, 0, 0], n_regions=3, segmentation=Fixed()).fit(x, y)
+    assert m.n_regions_ == 2
+    assert m.summary()["partition_columns"] == _used_columns(m)
+
+
+def test_refinement_that_empties_a_region_leaves_one_model():
+    """The classifier may only use x3, which does not tell the modes apart: refinement merges the
+    regions; the fit ends with one region and a warning instead of an empty-region error."""
+    x = np.random.default_rng(0).uniform(-1, 1, (800, 3))
+    y = np.where(x[:, 0] >= 0, x[:, 0] + 2.0, -x[:, 1] - 1.0)
+    with pytest.warns(RegionWarning, match="dropped"):
+        m = PWARX(0, [1, 1, 1], [0, 0, 0], n_regions=2, segmentation="alternating", random_state=0,
+                  partition_columns=["u3(k)"]).fit(x, y)
+    assert m.n_regions_ == 1 and m.partition_.n_regions == 1

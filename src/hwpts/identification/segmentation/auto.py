@@ -14,7 +14,13 @@ conditions. Two schemes:
 A candidate whose free run diverges on any block is rejected (a naive k-means PWARX diverges on
 the actuator data); among the rest, the best score wins, and a candidate within ``tolerance``
 percentage points of it is preferred when it has fewer regions or only stable modes (state-space
-poles inside the unit circle, eq. 7). The winner is refitted on all the training data.
+poles inside the unit circle, eq. 7). The winner is then scored once more with the
+simulation-error polish (``polish=True``, :mod:`hwpts.identification.polish`) on the same blocks and
+polished if that raises its held-out fit by more than ``tolerance`` (the rule between candidates:
+stability decides only within ``tolerance``; the row records the polished model's stability;
+``try_polish=False`` skips this). The winner is refitted on all the training data.
+``segmentation_params`` given to ``auto`` are its own: the candidates run with their methods'
+defaults.
 
 Candidates are independent: the search is a map over (method, n_regions) pairs.
 """
@@ -123,12 +129,11 @@ class AutoSegmenter(Segmenter):
                 row["heldout_fit_percent"] = float(np.mean(fits))
             return row
 
-        rows = []
-        for method, s in self.candidates(max_regions):
-            params = {**base, "segmentation": method, "n_regions": s}
-            row = scored(params, {"segmentation": method, "n_regions": s, "n_regions_fitted": None,
-                                  "heldout_fit_percent": None, "block_fits_percent": None, "stable": None})
-            if row["rejected"] is None:  # stability of the model fitted on all the data
+        def checked(params, row):
+            """Score on the blocks, then the stability of the model fitted on all the data."""
+            row = scored(params, {**row, "n_regions_fitted": None, "heldout_fit_percent": None,
+                                  "block_fits_percent": None, "stable": None})
+            if row["rejected"] is None:
                 full = estimator.__class__(**params)
                 try:
                     with warnings.catch_warnings():
@@ -138,7 +143,10 @@ class AutoSegmenter(Segmenter):
                     row["stable"] = bool(all(ss.stable for ss in full.state_space()))
                 except HwptsError as error:
                     row["rejected"] = f"fit failed: {error}"
-            rows.append(row)
+            return row
+
+        rows = [checked({**base, "segmentation": method, "n_regions": s}, {"segmentation": method, "n_regions": s})
+                for method, s in self.candidates(max_regions)]
         ok = [r for r in rows if r["rejected"] is None]
         if not ok:
             raise IdentificationError(
@@ -151,10 +159,11 @@ class AutoSegmenter(Segmenter):
         choice = {"segmentation": chosen["segmentation"], "n_regions": chosen["n_regions"],
                   "segmentation_params": None}
         if self.try_polish and not base.get("polish"):
-            row = scored({**base, **choice, "polish": True},
-                         {"segmentation": chosen["segmentation"], "n_regions": chosen["n_regions"], "polish": True,
-                          "heldout_fit_percent": None, "block_fits_percent": None})
+            row = checked({**base, **choice, "polish": True},
+                          {"segmentation": chosen["segmentation"], "n_regions": chosen["n_regions"], "polish": True})
             rows.append(row)
+            # the same rule as between candidates: a stable model is preferred only within
+            # ``tolerance``; the polish must gain more than that (and not diverge on any block)
             if row["rejected"] is None and row["heldout_fit_percent"] > chosen["heldout_fit_percent"] + self.tolerance:
                 chosen = row
                 choice["polish"] = True
