@@ -192,7 +192,6 @@ class PWARX(BaseEstimator):
 
         X_reg, target = structure.build(u, yy)
         self._pcols = None
-        self._sparse_columns = None
         if self.partition_columns is not None:
             self._pcols = sorted({structure.column_index(c) for c in self.partition_columns})
         n_regions = self.n_regions
@@ -202,11 +201,13 @@ class PWARX(BaseEstimator):
         seg = segmenter.segment(X_reg, target, n_regions, structure, rng)
         s = seg.n_regions
         kinds = self._kinds(s)
+        sparse_columns = None
         if seg.partition is not None:
             partition = seg.partition
             labels = partition.predict(X_reg)
         else:
-            labels, partition = self._learn_partition(X_reg, target, seg.labels, s, kinds, seg.refine, structure)
+            labels, partition, sparse_columns = self._learn_partition(X_reg, target, seg.labels, s, kinds,
+                                                                      seg.refine, structure)
             s = partition.n_regions
             kinds = self._kinds(s)
         learned = seg.partition is None and s > 1
@@ -226,9 +227,8 @@ class PWARX(BaseEstimator):
         self.output_range_ = (float(yy.min()), float(yy.max()))
         self.input_ranges_ = np.column_stack([u.min(axis=0), u.max(axis=0)])
         self.segmentation_info_ = {"method": str(self.segmentation), **seg.info}
-        if self._sparse_columns is not None:
-            self.segmentation_info_["partition_columns"] = [structure.feature_names[c]
-                                                            for c in self._sparse_columns]
+        if sparse_columns is not None:
+            self.segmentation_info_["partition_columns"] = [structure.feature_names[c] for c in sparse_columns]
         if self.polish:
             from hwpts.identification.polish import polish_free_run
 
@@ -287,26 +287,24 @@ class PWARX(BaseEstimator):
             if np.array_equal(new_labels, labels):
                 break
             labels = new_labels
-        if partition.n_regions != s:  # a region emptied in the last round (down to one region)
-            partition = fit_linear_partition(X, labels, s, C=self.classifier_C, columns=self._pcols)
-            labels = partition.predict(X)
-        columns = self._pcols
-        if self.sparse_partition and s > 1:
+        sparse_columns = None
+        if self.sparse_partition and s > 1:  # (s == 1 only when a round emptied all but one region)
             sparse = self._sparse_partition(train_X, train_labels, partition, s)
             if sparse is not None:
-                partition = sparse
-                columns = self._sparse_columns
+                partition, sparse_columns = sparse
                 labels = partition.predict(X)
-        labels2, s2 = self._drop_empty(labels, s)
-        if s2 != s:
-            partition = fit_linear_partition(X, labels2, s2, C=self.classifier_C, columns=columns)
-            labels2 = partition.predict(X)
-            if s2 == 1:
-                self._sparse_columns = None
-        return labels2, partition
+        # regions emptied by the last round or by the sparse classifier: refit on the ones left
+        labels, s = self._drop_empty(labels, s)
+        if partition.n_regions != s:
+            columns = self._pcols if sparse_columns is None else sparse_columns
+            partition = fit_linear_partition(X, labels, s, C=self.classifier_C, columns=columns)
+            labels = partition.predict(X)
+            if s == 1:
+                sparse_columns = None
+        return labels, partition, sparse_columns
 
     def _sparse_partition(self, X, labels, partition, s):
-        """The classifier refitted on the columns its boundaries use, or None (see ``sparse_partition``).
+        """``(classifier, columns)`` refitted on the columns its boundaries use, or None.
 
         ``X, labels`` are the classifier's own training rows (the last refinement round's confident
         samples, at most ``CLASSIFIER_ROWS``). A column is used when its weight in some boundary
@@ -319,26 +317,26 @@ class PWARX(BaseEstimator):
         W, _ = partition.scores
         sd = X.std(axis=0)
         sd[sd == 0] = 1.0
+        weight = np.zeros(X.shape[1])  # largest relative weight of each column over the normals
+        for i in range(s):
+            for j in range(i + 1, s):
+                normal = np.abs(W[i] - W[j]) * sd
+                if normal.max() > 0:
+                    weight = np.maximum(weight, normal / normal.max())
         allowed = np.zeros(X.shape[1], dtype=bool)
         allowed[self._pcols if self._pcols is not None else slice(None)] = True
-        errors_full = int(np.sum(partition.predict(X) != labels))
-        slack = max(1, int(0.001 * labels.size))
+        errors_full = None
         tried = None
         for tol in (SPARSE_TOL, SPARSE_TOL / 10):
-            used = np.zeros(X.shape[1], dtype=bool)
-            for i in range(s):
-                for j in range(i + 1, s):
-                    normal = np.abs(W[i] - W[j]) * sd
-                    if normal.max() > 0:
-                        used |= normal >= tol * normal.max()
-            used &= allowed
+            used = allowed & (weight >= tol)
             if not used.any() or used.sum() == allowed.sum() or (tried is not None and np.array_equal(used, tried)):
                 continue
             tried = used
+            if errors_full is None:
+                errors_full = int(np.sum(partition.predict(X) != labels))
             reduced = fit_linear_partition(X, labels, s, C=self.classifier_C, columns=np.flatnonzero(used))
-            if int(np.sum(reduced.predict(X) != labels)) <= errors_full + slack:
-                self._sparse_columns = np.flatnonzero(used)
-                return reduced
+            if int(np.sum(reduced.predict(X) != labels)) <= errors_full + max(1, int(0.001 * labels.size)):
+                return reduced, np.flatnonzero(used)
         return None
 
     @staticmethod

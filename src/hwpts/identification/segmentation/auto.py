@@ -17,8 +17,7 @@ percentage points of it is preferred when it has fewer regions or only stable mo
 poles inside the unit circle, eq. 7). The winner is then scored once more with the
 simulation-error polish (``polish=True``, :mod:`hwpts.identification.polish`) on the same blocks and
 polished if that raises its held-out fit by more than ``tolerance`` (the rule between candidates:
-stability decides only within ``tolerance``; the row records the polished model's stability;
-``try_polish=False`` skips this). The winner is refitted on all the training data.
+stability decides only within ``tolerance``; ``try_polish=False`` skips this). The winner is refitted on all the training data.
 ``segmentation_params`` given to ``auto`` are its own: the candidates run with their methods'
 defaults.
 
@@ -129,11 +128,12 @@ class AutoSegmenter(Segmenter):
                 row["heldout_fit_percent"] = float(np.mean(fits))
             return row
 
-        def checked(params, row):
-            """Score on the blocks, then the stability of the model fitted on all the data."""
-            row = scored(params, {**row, "n_regions_fitted": None, "heldout_fit_percent": None,
-                                  "block_fits_percent": None, "stable": None})
-            if row["rejected"] is None:
+        rows = []
+        for method, s in self.candidates(max_regions):
+            params = {**base, "segmentation": method, "n_regions": s}
+            row = scored(params, {"segmentation": method, "n_regions": s, "n_regions_fitted": None,
+                                  "heldout_fit_percent": None, "block_fits_percent": None, "stable": None})
+            if row["rejected"] is None:  # stability of the model fitted on all the data
                 full = estimator.__class__(**params)
                 try:
                     with warnings.catch_warnings():
@@ -143,10 +143,7 @@ class AutoSegmenter(Segmenter):
                     row["stable"] = bool(all(ss.stable for ss in full.state_space()))
                 except HwptsError as error:
                     row["rejected"] = f"fit failed: {error}"
-            return row
-
-        rows = [checked({**base, "segmentation": method, "n_regions": s}, {"segmentation": method, "n_regions": s})
-                for method, s in self.candidates(max_regions)]
+            rows.append(row)
         ok = [r for r in rows if r["rejected"] is None]
         if not ok:
             raise IdentificationError(
@@ -159,8 +156,11 @@ class AutoSegmenter(Segmenter):
         choice = {"segmentation": chosen["segmentation"], "n_regions": chosen["n_regions"],
                   "segmentation_params": None}
         if self.try_polish and not base.get("polish"):
-            row = checked({**base, **choice, "polish": True},
-                          {"segmentation": chosen["segmentation"], "n_regions": chosen["n_regions"], "polish": True})
+            # the polish keeps the partition, so no fit on all the data here: the winner's refit
+            # follows anyway
+            row = scored({**base, **choice, "polish": True},
+                         {"segmentation": chosen["segmentation"], "n_regions": chosen["n_regions"], "polish": True,
+                          "heldout_fit_percent": None, "block_fits_percent": None})
             rows.append(row)
             # the same rule as between candidates: a stable model is preferred only within
             # ``tolerance``; the polish must gain more than that (and not diverge on any block)
