@@ -73,18 +73,18 @@ def expand_grid(grid) -> list[dict]:
     return out
 
 
-def _score_split(estimator, params, u, y, train, test):
+def _score_split(estimator, params, u, y, train, test, names=None, output_name=None):
     """Free-run fit % of ``params`` fitted on ``train``, simulated over ``test`` (nan if diverged)."""
     model = clone(estimator).set_params(**params)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        model.fit(u[train], y[train], breaks=breaks_of(train) or None)
+        model.fit(u[train], y[train], names, output_name, breaks=breaks_of(train) or None)
         start, stop = int(test[0]), int(test[-1]) + 1
         sim = model.simulate(u[start:stop], y[start:stop])
     return sim.score(y[start:stop]), int(model.n_regions_)
 
 
-def _evaluate(estimator, params, u, y, splits, prune_below=-np.inf):
+def _evaluate(estimator, params, u, y, splits, prune_below=-np.inf, names=None, output_name=None):
     """One table row: the candidate's block fits, mean, or why it failed. A candidate whose running
     mean falls ``PRUNE_MARGIN`` points below ``prune_below`` (the best complete mean so far) is not
     scored on its remaining blocks (``pruned``; ranked after the complete ones)."""
@@ -94,7 +94,7 @@ def _evaluate(estimator, params, u, y, splits, prune_below=-np.inf):
     fits, regions = [], []
     try:
         for train, test in splits:
-            fit, s = _score_split(estimator, params, u, y, train, test)
+            fit, s = _score_split(estimator, params, u, y, train, test, names, output_name)
             fits.append(fit)
             regions.append(s)
             if not np.isfinite(fit):
@@ -235,15 +235,17 @@ class PWARXSearch(BaseEstimator):
     def _run(self, base, candidates, u, y, splits, stage, bar, best=-np.inf):
         from joblib import Parallel, delayed
 
+        names, oname = self._names
         if self.n_jobs in (None, 1):
             rows = []
             for params in candidates:
-                rows.append(_evaluate(base, params, u, y, splits, best))
+                rows.append(_evaluate(base, params, u, y, splits, best, names, oname))
                 best = max(best, self._score(rows[-1]))
                 if bar is not None:
                     bar.update(1)
         else:
-            rows = Parallel(n_jobs=self.n_jobs)(delayed(_evaluate)(base, p, u, y, splits) for p in candidates)
+            rows = Parallel(n_jobs=self.n_jobs)(delayed(_evaluate)(base, p, u, y, splits, -np.inf, names, oname)
+                                                for p in candidates)
             if bar is not None:
                 bar.update(len(candidates))
         for row in rows:
@@ -260,6 +262,7 @@ class PWARXSearch(BaseEstimator):
         """Search, then refit the winner on all of ``(X, y)`` (or an IODataset). Returns ``self``."""
         base = self._base()
         u, yy, names, oname = base._signals(X, y, input_names, output_name)
+        self._names = (names, oname)
         n = yy.shape[0]
         if isinstance(self.tolerance, bool) or not isinstance(self.tolerance, (int, float)) or not self.tolerance >= 0:
             raise ParameterError(f"PWARXSearch: tolerance must be a number >= 0, got {self.tolerance!r}")
@@ -392,7 +395,7 @@ class PWARXSearch(BaseEstimator):
             if polish == "auto":
                 polish = y.shape[0] <= 5000 and params.get("output_order", base.output_order) > 0
             if polish and not clone(base).set_params(**params).polish:
-                trial = _evaluate(base, {**params, "polish": True}, u, y, splits)
+                trial = _evaluate(base, {**params, "polish": True}, u, y, splits, -np.inf, *self._names)
                 trial["stage"] = "polish"
                 table.append(trial)
                 if trial["mean_fit_percent"] is not None and \
