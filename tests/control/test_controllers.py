@@ -123,3 +123,21 @@ def test_low_wind_no_windup_and_recovery(paper_model_doc):
     valve = runs["pi"]["valve_compensated_v"]
     t = runs["pi"]["time_s"]
     assert valve[(t > 20) & (t < 30)].max() < 1.5  # saturated fully open while out of reach
+
+
+def test_mpc_rejects_a_pump_step_without_failed_solves(paper_model_doc):
+    """The QP MPC on the predicted region sequence: a +200 r/min pump step at 4 s, 8 s record."""
+    from hwpts.control.controllers import make_controller
+    from hwpts.control.loop import run_loop
+    from hwpts.control.metrics import compute_metrics
+    from hwpts.control.scenarios import build_scenario
+
+    doc, r_hat, ts = paper_model_doc
+    bank = ModelBank(doc, ts)
+    sc = build_scenario("pump-step", duration=8.0)
+    c = make_controller("mpc", bank, r_hat, sc)
+    result = run_loop(sc, c)
+    m = compute_metrics(sc, result, True)
+    assert c.solves == sc.time.size and c.failed_solves == 0
+    assert m["recovery_time_s"] is not None and m["recovery_time_s"] < 1.5
+    assert m["rms_error_percent"] < 1.0

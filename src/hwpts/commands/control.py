@@ -7,7 +7,7 @@ import sys
 
 from hwpts.commands._args import finite_float, non_negative_int
 
-DEFAULT_CONTROLLERS = "pi,pi-no-inverse,scheduled,scheduled-no-inverse,mmac,mmac-no-inverse,reference"
+DEFAULT_CONTROLLERS = "pi,pi-no-inverse,scheduled,scheduled-no-inverse,mmac,mmac-no-inverse,mpc,mpc-no-inverse,reference"
 SCENARIOS = ("setpoint-step", "pump-step", "load-step", "turbulence-a", "turbulence-b", "turbulence-c", "low-wind")
 
 

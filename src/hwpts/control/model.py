@@ -21,6 +21,9 @@ import numpy as np
 
 from hwpts.errors import DataError
 
+FLAT_GAIN_SHARE = 0.2
+"""A region whose valve gain is below this share of the stiffest region's is 'flat' for feedforward."""
+
 VALVE_WORDS = ("valve",)
 PUMP_WORDS = ("pump",)
 
@@ -89,6 +92,11 @@ class ModelBank:
         self.main_region = main
         """The region with the most training samples: its valve gain's sign is the plant's."""
         self.control_regions = tuple(i for i in usable if np.sign(gains[i]) == np.sign(gains[main]))
+        stiff = max(abs(gains[i]) for i in self.control_regions)
+        self.stiffest_region = max(self.control_regions, key=lambda i: abs(gains[i]))
+        self.feedforward_regions = tuple(i for i in self.control_regions if abs(gains[i]) >= FLAT_GAIN_SHARE * stiff)
+        """Regions whose steady state is well conditioned in the valve: a flat region (the pump-limited
+        plateau, where the valve hardly moves the speed) would turn a small speed difference into volts."""
         """Regions a controller may design from: stable, and the valve acting with the main region's sign
         (a region whose fitted gain has the other sign, e.g. the closed valve hi >= 3.5 V where the motor
         only spins down, holds no usable operating point)."""
@@ -149,6 +157,11 @@ class ModelBank:
         a, b, c, d = self._sums(i)
         return (b * u1 + c * u2 + d) / (1.0 - a)
 
+    def stiff_valve(self, y: float, u2: float) -> float:
+        """The stiffest region's steady-state valve voltage for y at u2, whether or not it lies in that region."""
+        a, b, c, d = self._sums(self.stiffest_region)
+        return (y * (1.0 - a) - c * u2 - d) / b
+
     def steady_valve(self, y: float, u2: float, limits=(1.2, 3.8)):
         """(u1, region): the valve voltage holding output y at pump speed u2 in steady state.
 
@@ -156,7 +169,7 @@ class ModelBank:
         with the largest valve gain when several are). None when no region can hold y.
         """
         found = []
-        for i in self.control_regions:
+        for i in self.feedforward_regions:
             a, b, c, d = self._sums(i)
             if self.kinds[i] == "zero" or abs(b) < 1e-9:
                 continue

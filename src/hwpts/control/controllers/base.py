@@ -97,10 +97,11 @@ class PILaw:
         self.integral = output - feedforward - self.gains.kp * error
         self.output = output
 
-    def __call__(self, error: float, feedforward: float) -> float:
+    def __call__(self, error: float, feedforward: float, hold: bool = False) -> float:
+        """One sample; ``hold`` keeps the integral as it is (conditional integration)."""
         g = self.gains
         p = feedforward + g.kp * error
-        integral = self.integral + g.kp * self.dt / g.ti * error
+        integral = self.integral if hold else self.integral + g.kp * self.dt / g.ti * error
         lo, hi = self.limits
         integral = min(max(integral, lo - p), hi - p)
         self.integral = integral

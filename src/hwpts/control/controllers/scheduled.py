@@ -12,8 +12,14 @@ from __future__ import annotations
 import math
 
 from hwpts.control.controllers.base import Controller, HysteresisInverse, LowPass, ModelRateHistory, PILaw
-from hwpts.control.controllers.pi import CLOSED_LOOP_TIME_S, SPEED_FILTER_S, region_gains
+from hwpts.control.controllers.pi import SPEED_FILTER_S, region_gains
 from hwpts.control.model import ModelBank
+
+CLOSED_LOOP_TIME_S = 0.08
+"""tau_c of the SIMC rule per region [s] (the best of 0.05-0.15 s on class A turbulence)."""
+
+FLAT_GAIN_CAP = 10.0
+"""A flat region's proportional gain is capped at this multiple of the stiffest region's."""
 
 PUMP_FILTER_S = 0.05
 """Low-pass on the measured pump speed feeding the feedforward [s]."""
@@ -39,7 +45,7 @@ class ScheduledController(Controller):
         lims = self.inverse.effective_limits
         gains = {i: region_gains(bank, i, closed_loop_time) for i in bank.control_regions}
         stiffest = max(gains, key=lambda i: abs(bank.designs[i].valve_gain_rpm_per_v))
-        cap = 3.0 * abs(gains[stiffest].kp)
+        cap = FLAT_GAIN_CAP * abs(gains[stiffest].kp)
         # a region whose valve gain is near zero (the pump-limited plateau) would get a huge gain: cap it
         self.laws = {i: PILaw(type(g)(math.copysign(min(abs(g.kp), cap), g.kp), g.ti), sample_time, lims)
                      for i, g in gains.items()}
@@ -62,9 +68,10 @@ class ScheduledController(Controller):
     def _feedforward(self, setpoint, pump, region):
         u, found = self.bank.steady_valve(setpoint, pump)
         if found is None:
+            # no well-conditioned region holds the set-point here (out of reach, or on the plateau):
+            # the stiffest region's answer, within the limits; the integral does the rest
             lo, hi = self.inverse.effective_limits
-            # out of reach: the direction of the valve gain decides which limit helps
-            return lo if self.bank.designs[self.bank.main_region].valve_gain_rpm_per_v < 0 else hi
+            return min(max(self.bank.stiff_valve(setpoint, pump), lo), hi)
         return u
 
     def reset(self, setpoint, speed, pump, command):
@@ -97,7 +104,16 @@ class ScheduledController(Controller):
                     self.laws[new].reset_to(previous, self.feedforward, setpoint - y)
         self.feedforward = self._feedforward(setpoint, w, self.region)
         law = self.laws[self.region]
-        desired = law(setpoint - y, self.feedforward)
+        e = setpoint - y
+        if self.region not in self.bank.feedforward_regions:
+            # a flat region (the pump-limited plateau): there the integral may open the valve wide (through
+            # the prime mover's droop that still gains a little speed); once the speed asks for the other
+            # direction, the valve goes straight back to the stiff region's steady state instead of
+            # unwinding that integral at the integral rate
+            toward = self.bank.stiff_valve(setpoint, w) - law.output
+            if law.gains.kp * e * toward > 0.0 and law.integral * toward < 0.0:
+                law.integral = 0.0
+        desired = law(e, self.feedforward)
         self.command = self.inverse(desired)
         return self.command
 
