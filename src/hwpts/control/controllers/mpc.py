@@ -65,6 +65,8 @@ class MPCController(Controller):
             self.block[edges[j]:edges[j + 1]] = j
         self.plan = None
         self.offset = 0.0
+        self._cache = {}
+        self._diff = np.eye(self.moves) - np.eye(self.moves, k=-1)
         self.solves = 0
         self.failed_solves = 0
 
@@ -142,22 +144,36 @@ class MPCController(Controller):
         base_u = self.plan[self.block]
         y0, regs = self._predict(y_model, u1_hist, u2_hist, base_u)
         y0 = y0 + self.offset
-        sens = np.empty((self.horizon, self.moves))
-        for j in range(self.moves):
-            du = base_u + (self.block == j)
-            yj, _ = self._predict(y_model, u1_hist, u2_hist, du, regs)
-            sens[:, j] = yj + self.offset - y0
+        # with the regions fixed the model is affine in the moves, and the sensitivity to them depends
+        # on the region sequence only: computed once per sequence, with the unconstrained solution's
+        # pseudo-inverse
+        key = regs.tobytes()
+        cached = self._cache.get(key)
+        if cached is None:
+            sens = np.empty((self.horizon, self.moves))
+            for j in range(self.moves):
+                du = base_u + (self.block == j)
+                yj, _ = self._predict(y_model, u1_hist, u2_hist, du, regs)
+                sens[:, j] = yj + self.offset - y0
+            a = np.vstack([sens, math.sqrt(self.move_weight) * self._diff])
+            cached = (sens, a, np.linalg.pinv(a))
+            if len(self._cache) > 512:
+                self._cache.clear()
+            self._cache[key] = cached
+        sens, a, a_pinv = cached
         target = setpoint - y0 + sens @ self.plan  # y = y0 + S (u - plan)
         # least squares: [S; sqrt(l) D] u ~ [target; sqrt(l) d0]
-        d = np.eye(self.moves) - np.eye(self.moves, k=-1)
         d0 = np.zeros(self.moves)
         d0[0] = u_prev
-        w = math.sqrt(self.move_weight)
-        a = np.vstack([sens, w * d])
-        b = np.concatenate([target, w * d0])
+        b = np.concatenate([target, math.sqrt(self.move_weight) * d0])
         steps = (np.arange(self.moves) + 1) * self.rate
         lower = np.maximum(lo, u_prev - steps)
         upper = np.minimum(hi, u_prev + steps)
+        free = a_pinv @ b
+        if np.all(free >= lower) and np.all(free <= upper):
+            self.solves += 1
+            self.plan = free  # the bounds are inactive: the QP's solution is the unconstrained one
+            return self.inverse(float(self.plan[0]))
         self.solves += 1
         try:
             sol = lsq_linear(a, b, bounds=(lower, upper), method="bvls")
