@@ -3,7 +3,7 @@
 from hwpts.plant.dynamics import jacobian, linearize, paper_form, rhs, transfer_poles_zeros
 from hwpts.plant.parameters import PlantParameters
 from hwpts.plant.profiles import CASE_NAMES, InputProfile, identification_excitation, validation_case
-from hwpts.plant.simulate import PlantResponse, SolverStats, simulate_plant
+from hwpts.plant.simulate import PlantResponse, PlantStepper, SolverStats, simulate_plant
 from hwpts.plant.steady_state import SteadyState, SweepResult, steady_state, sweep
 from hwpts.plant.testbed import TestBed
 from hwpts.plant.valve import orifice_flow, outlet_areas, play_operator, spool_position
@@ -13,6 +13,7 @@ __all__ = [
     "InputProfile",
     "PlantParameters",
     "PlantResponse",
+    "PlantStepper",
     "SolverStats",
     "SteadyState",
     "SweepResult",

@@ -51,6 +51,8 @@ _PRV = _I["relief_pressure"]
 _KRV = _I["relief_gain"]
 _KMU = _I["makeup_gain"]
 _KDR = _I["droop_gain"]
+_KG = _I["generator_slip_gain"]
+_WSYNC = _I["generator_synchronous_speed"]
 
 
 @numba.njit(cache=True)
@@ -61,7 +63,11 @@ def pump_speed_actual(pump_pressure, pump_speed_command, p):
 
 @numba.njit(cache=True)
 def rhs_into(x, h, wp_cmd, p, dx):
-    """Write F(x, h, w_p,cmd) into dx[0:5]: the full model (relief, make-up, droop), PLANT.md section 2."""
+    """Write F(x, h, w_p,cmd) into dx[0:5]: the full model (relief, make-up, droop), PLANT.md section 2.
+
+    With the generator option (K_g > 0, off by default) shaft A also carries the induction
+    generator's slip torque K_g * (w_A - w_sync), linear in the slip as below the breakdown torque.
+    """
     pp = x[0]
     pa = x[1]
     pb = x[2]
@@ -81,7 +87,7 @@ def rhs_into(x, h, wp_cmd, p, dx):
     dx[0] = p[_BETA] / p[_VP] * (qp - qa - qb - qrv + kmu * smooth_max0(-pp, MAKEUP_SMOOTHING_PA))
     dx[1] = p[_BETA] / p[_VA] * (qa - p[_DMA] * wa - p[_CSA] * pa + kmu * smooth_max0(-pa, MAKEUP_SMOOTHING_PA))
     dx[2] = p[_BETA] / p[_VB] * (qb - p[_DMB] * wb - p[_CSB] * pb + kmu * smooth_max0(-pb, MAKEUP_SMOOTHING_PA))
-    dx[3] = (p[_DMA] * pa - p[_BA] * wa - p[_TCA] * math.tanh(wa / p[_WS])) / p[_JA]
+    dx[3] = (p[_DMA] * pa - p[_BA] * wa - p[_TCA] * math.tanh(wa / p[_WS]) - p[_KG] * (wa - p[_WSYNC])) / p[_JA]
     dx[4] = (p[_DMB] * pb - p[_BB] * wb - p[_TCB] * math.tanh(wb / p[_WS])) / p[_JB]
 
 
@@ -126,7 +132,7 @@ def jacobian_into(x, h, wp_cmd, p, jac, dfdh):
     ta = math.tanh(wa / p[_WS])
     tb = math.tanh(wb / p[_WS])
     jac[3, 1] = p[_DMA] / p[_JA]
-    jac[3, 3] = (-p[_BA] - p[_TCA] / p[_WS] * (1.0 - ta * ta)) / p[_JA]
+    jac[3, 3] = (-p[_BA] - p[_TCA] / p[_WS] * (1.0 - ta * ta) - p[_KG]) / p[_JA]
     jac[4, 2] = p[_DMB] / p[_JB]
     jac[4, 4] = (-p[_BB] - p[_TCB] / p[_WS] * (1.0 - tb * tb)) / p[_JB]
     dfdh[0] = -kp * (dqa_dh + dqb_dh)
@@ -182,7 +188,8 @@ def paper_form(parameters: PlantParameters, state):
             ka * (k * phi_a - p.motor_a_displacement * wa - p.motor_a_leakage * pa),
             kb * (-p.motor_b_displacement * wb - p.motor_b_leakage * pb),
             (p.motor_a_displacement * pa - p.motor_a_damping * wa
-             - p.motor_a_load_torque * math.tanh(wa / p.coulomb_speed_width)) / p.motor_a_inertia,
+             - p.motor_a_load_torque * math.tanh(wa / p.coulomb_speed_width)
+             - p.generator_slip_gain * (wa - p.generator_synchronous_speed)) / p.motor_a_inertia,
             (p.motor_b_displacement * pb - p.motor_b_damping * wb
              - p.motor_b_load_torque * math.tanh(wb / p.coulomb_speed_width)) / p.motor_b_inertia,
         ]

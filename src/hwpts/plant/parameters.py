@@ -92,6 +92,11 @@ class PlantParameters:
     """K_mu: make-up check valve gain keeping pressures >= 0 [m^3/(s Pa)] (numerical)."""
     droop_gain: float = 0.0
     """K_droop: prime-mover droop, w_p = w_p,cmd - K_droop * D_p * P_p [(rad/s)/(N m)]; test bed 3.37 (tuned)."""
+    generator_slip_gain: float = 0.0
+    """K_g: slope of the induction generator's slip torque on shaft A, T_g = K_g * (w_A - w_sync)
+    [N m s/rad] (an option of ours, not in the paper; 0 = off, the paper's 5-state plant)."""
+    generator_synchronous_speed: float = 1000.0 * math.pi / 30.0
+    """w_sync: synchronous speed of the induction generator on shaft A [rad/s] (1000 r/min; used when K_g > 0)."""
 
     def __post_init__(self):
         for f in dataclasses.fields(self):
@@ -105,7 +110,7 @@ class PlantParameters:
             "leak_area", "hysteresis_half_width", "spool_time_constant", "aux_opening_pressure",
             "pump_leakage", "motor_a_leakage", "motor_b_leakage", "motor_a_damping",
             "motor_b_damping", "motor_a_load_torque", "motor_b_load_torque", "relief_gain",
-            "makeup_gain", "droop_gain",
+            "makeup_gain", "droop_gain", "generator_slip_gain",
         }
         for f in dataclasses.fields(self):
             value = getattr(self, f.name)

@@ -316,3 +316,91 @@ def simulate_plant(
         pump_speed_rpm=wp_actual * RPM_PER_RAD_S,
         stats=SolverStats(int(stats[0]), int(stats[1]), int(stats[2]), int(stats[3])),
     )
+
+
+class PlantStepper:
+    """The plant advanced one sample at a time, for closed-loop simulation.
+
+    The controller computes its command from what it measured at t_k; :meth:`step` holds that
+    command (zero-order hold) over [t_k, t_k + sample_time) with the same compiled ROS2 integrator
+    as :func:`simulate_plant`, carrying the state, the spool and the play operator's output from
+    one call to the next. A load factor scales the load on shaft A (its constant torque T_cA and
+    the generator's slip torque K_g), which is how electric load steps are applied.
+
+    Parameters
+    ----------
+    parameters : PlantParameters
+    sample_time : float
+        Length of one step [s].
+    valve_voltage, pump_speed : float
+        The inputs the plant starts in steady state at: valve command [V] (the play centred on
+        it) and pump speed command [r/min].
+    """
+
+    def __init__(self, parameters: PlantParameters, sample_time: float, valve_voltage: float, pump_speed: float,
+                 rtol: float = DEFAULT_RTOL, max_step: float = 0.05):
+        if not (math.isfinite(sample_time) and sample_time > 0):
+            raise DataError(f"sample_time must be a positive number of seconds, got {sample_time!r}")
+        if not (math.isfinite(valve_voltage) and math.isfinite(pump_speed) and pump_speed >= 0):
+            raise DataError(f"initial inputs must be finite with pump speed >= 0, got {valve_voltage!r} V, {pump_speed!r} r/min")
+        self.parameters = parameters
+        self.sample_time = float(sample_time)
+        self._p = parameters.as_array()
+        self._base_load = (self._p[_I["motor_a_load_torque"]], self._p[_I["generator_slip_gain"]])
+        self._r = parameters.hysteresis_half_width
+        self._t = np.array([0.0, self.sample_time])
+        self._h = np.zeros(2)
+        self._w = np.zeros(2)
+        self._out = np.empty((2, _NZ))
+        self._stats = np.zeros(4, dtype=np.int64)
+        self._atol = np.array(DEFAULT_ATOL)
+        self._rtol = float(rtol)
+        self._max_step = float(max_step)
+        self.effective_voltage_v = float(valve_voltage)
+        h0 = spool_position(np.array([valve_voltage]), parameters)
+        x0, _ = solve_steady_state(parameters, h0, np.array([pump_speed * RAD_S_PER_RPM]))
+        self._z = np.concatenate([x0[0], h0])
+        self.time = 0.0
+        self.load_factor = 1.0
+
+    @property
+    def state(self) -> np.ndarray:
+        """x(t) in SI (a copy)."""
+        return self._z[:N_STATES].copy()
+
+    @property
+    def motor_a_speed_rpm(self) -> float:
+        return float(self._z[3] * RPM_PER_RAD_S)
+
+    def pump_speed_rpm(self, pump_speed_command_rpm: float) -> float:
+        """The actual pump speed [r/min] at the present pump pressure (after droop)."""
+        p = self._p
+        return float(pump_speed_command_rpm - p[_I["droop_gain"]] * p[_I["pump_displacement"]] * self._z[0]
+                     * RPM_PER_RAD_S)
+
+    def set_load_factor(self, factor: float) -> None:
+        """Scale the load on shaft A (1 = nominal; 1.3 = a +30 % electric load step)."""
+        if not (math.isfinite(factor) and factor >= 0):
+            raise DataError(f"load factor must be a finite number >= 0, got {factor!r}")
+        self.load_factor = float(factor)
+        self._p[_I["motor_a_load_torque"]] = self._base_load[0] * factor
+        self._p[_I["generator_slip_gain"]] = self._base_load[1] * factor
+
+    def step(self, valve_voltage: float, pump_speed: float) -> None:
+        """Hold the valve command [V] and the pump speed command [r/min] over one sample."""
+        if not (math.isfinite(valve_voltage) and math.isfinite(pump_speed)):
+            raise DataError(f"non-finite input at t = {self.time:.3f} s: {valve_voltage!r} V, {pump_speed!r} r/min")
+        r = self._r
+        v_eff = min(max(self.effective_voltage_v, valve_voltage - r), valve_voltage + r)
+        self.effective_voltage_v = v_eff
+        p = self.parameters
+        span = p.valve_voltage_closed - p.valve_voltage_open
+        self._h[0] = p.spool_stroke * min(max((v_eff - p.valve_voltage_open) / span, 0.0), 1.0)
+        self._w[0] = max(pump_speed, 0.0) * RAD_S_PER_RPM
+        failed = _integrate(self._t, self._h, self._w, self._p, self._z, self._rtol, self._atol, self._max_step,
+                            self._out, self._stats)
+        if failed >= 0:
+            raise SimulationError(f"integration failed in the sample after t = {self.time:.6g} s "
+                                  "(step size underflow or non-finite state)")
+        self._z[:] = self._out[1]
+        self.time += self.sample_time

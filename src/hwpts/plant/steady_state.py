@@ -61,19 +61,22 @@ _RELIEF_GAIN = _I["relief_gain"]
 _RELIEF_PRESSURE = _I["relief_pressure"]
 _SMOOTHING_PRESSURE = _I["smoothing_pressure"]
 _SPOOL_STROKE = _I["spool_stroke"]
+_GENERATOR_SLIP_GAIN = _I["generator_slip_gain"]
+_GENERATOR_SYNCHRONOUS_SPEED = _I["generator_synchronous_speed"]
 
 _FLOW_SCALE = 1e-4  # m^3/s, typical flow: the reported residual is divided by it
 
 
 @numba.njit(cache=True)
-def _branch(w, pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu, out):
+def _branch(w, pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu, out, slip=0.0, w_sync=0.0):
     """Flow balance g of one motor branch at shaft speed w and supply pressure pp (g falls with w).
 
+    ``slip``, ``w_sync``: the optional generator's slip torque slip * (w - w_sync) (0: none).
     Writes (g, dg/dw, dg/dpp, dQ/dpp at fixed w, dQ/dw) into out; returns the orifice flow Q.
     """
     th = math.tanh(w / ws)
-    pm = (damping * w + torque * th) / dm
-    dpm = (damping + torque / ws * (1.0 - th * th)) / dm
+    pm = (damping * w + torque * th + slip * (w - w_sync)) / dm
+    dpm = (damping + torque / ws * (1.0 - th * th) + slip) / dm
     dp = pp - pm - opening
     q = c * area * orifice_shape(dp, pcr, eps)
     dq = c * area * orifice_shape_derivative(dp, pcr, eps)
@@ -107,7 +110,7 @@ def _rtsafe_step(x, f, df, lo, hi, dx, dx_old):
 
 
 @numba.njit(cache=True)
-def _branch_speed(pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu, out, guess):
+def _branch_speed(pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu, out, guess, slip=0.0, w_sync=0.0):
     """The unique shaft speed balancing a motor branch: safeguarded Newton on a bracket.
 
     ``guess`` (e.g. the solution at a nearby pressure) starts the iteration when inside the
@@ -115,18 +118,18 @@ def _branch_speed(pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, k
     """
     lo = -1.0
     hi = max(pp, 1.0) * dm / damping + 10.0
-    _branch(lo, pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu, out)
+    _branch(lo, pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu, out, slip, w_sync)
     if out[0] <= 0.0:
         return lo
     w = guess if lo < guess < hi else min(max(pp - opening, 0.0) * dm * dm / (damping * dm + 1e-3), 0.5 * hi)
     dx_old = hi - lo
     dx = dx_old
     for _ in range(200):
-        _branch(w, pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu, out)
+        _branch(w, pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu, out, slip, w_sync)
         w, dx, dx_old, lo, hi = _rtsafe_step(w, out[0], out[1], lo, hi, dx, dx_old)
         if abs(dx) <= 1e-12 * (1.0 + abs(w)):
             break
-    _branch(w, pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu, out)
+    _branch(w, pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu, out, slip, w_sync)
     return w
 
 
@@ -146,8 +149,10 @@ def _pump_balance(pp, h, wp_cmd, p, speeds, work):
     ws = p[_COULOMB_SPEED_WIDTH]
     out = work[1:]
     wa = _branch_speed(pp, area_a, 0.0, p[_MOTOR_A_DISPLACEMENT], p[_MOTOR_A_LEAKAGE], p[_MOTOR_A_DAMPING],
-                       p[_MOTOR_A_LOAD_TORQUE], ws, c, pcr, eps, kmu, out, speeds[0])
-    qa = c * area_a * orifice_shape(pp - (p[_MOTOR_A_DAMPING] * wa + p[_MOTOR_A_LOAD_TORQUE] * math.tanh(wa / ws))
+                       p[_MOTOR_A_LOAD_TORQUE], ws, c, pcr, eps, kmu, out, speeds[0],
+                       p[_GENERATOR_SLIP_GAIN], p[_GENERATOR_SYNCHRONOUS_SPEED])
+    qa = c * area_a * orifice_shape(pp - (p[_MOTOR_A_DAMPING] * wa + p[_MOTOR_A_LOAD_TORQUE] * math.tanh(wa / ws)
+                                          + p[_GENERATOR_SLIP_GAIN] * (wa - p[_GENERATOR_SYNCHRONOUS_SPEED]))
                                     / p[_MOTOR_A_DISPLACEMENT], pcr, eps)
     dqa = out[3] + out[4] * (-out[2] / out[1])
     wb = _branch_speed(pp, area_b, p[_AUX_OPENING_PRESSURE], p[_MOTOR_B_DISPLACEMENT], p[_MOTOR_B_LEAKAGE],
@@ -203,7 +208,8 @@ def _solve_points(spool, wp_cmd, p, out, iterations, residual, tol, max_iter):
         wb = speeds[1]
         ws = p[_COULOMB_SPEED_WIDTH]
         out[k, 0] = pp
-        out[k, 1] = (p[_MOTOR_A_DAMPING] * wa + p[_MOTOR_A_LOAD_TORQUE] * math.tanh(wa / ws)) / p[_MOTOR_A_DISPLACEMENT]
+        out[k, 1] = (p[_MOTOR_A_DAMPING] * wa + p[_MOTOR_A_LOAD_TORQUE] * math.tanh(wa / ws)
+                     + p[_GENERATOR_SLIP_GAIN] * (wa - p[_GENERATOR_SYNCHRONOUS_SPEED])) / p[_MOTOR_A_DISPLACEMENT]
         out[k, 2] = (p[_MOTOR_B_DAMPING] * wb + p[_MOTOR_B_LOAD_TORQUE] * math.tanh(wb / ws)) / p[_MOTOR_B_DISPLACEMENT]
         out[k, 3] = wa
         out[k, 4] = wb

@@ -1,0 +1,216 @@
+"""``hwpts control run``: speed control of the test bed from an identified PWARX model bank."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from hwpts.commands._args import finite_float, non_negative_int
+
+DEFAULT_CONTROLLERS = "pi,pi-no-inverse,scheduled,scheduled-no-inverse,mmac,mmac-no-inverse,mpc,mpc-no-inverse,reference"
+SCENARIOS = ("setpoint-step", "pump-step", "load-step", "turbulence-a", "turbulence-b", "turbulence-c", "low-wind")
+
+
+def _positive(text):
+    value = finite_float(text)
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"expected a number > 0, got {text!r}")
+    return value
+
+
+def _count(text):
+    value = non_negative_int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}")
+    return value
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser("control", help="closed-loop speed control from an identified model bank",
+                              description="Design speed controllers from a PWARX model bank and run them closed loop "
+                              "on the simulated test bed under wind and load disturbances.")
+    sub = p.add_subparsers(dest="control_command", metavar="SUBCOMMAND", parser_class=type(p))
+    sub.required = True
+    r = sub.add_parser("run", help="one scenario, several controllers: summary.json, data, figures, report.html",
+                       description="Run the controllers on one scenario. Writes DIR/summary.json (schema hwpts.control/1), "
+                       "DIR/data/*.csv, DIR/figures/*.png and DIR/report.html. Without --model the model bank is "
+                       "identified first as 'hwpts reproduce' does (method 'paper').")
+    r.add_argument("--scenario", required=True, metavar="NAME", help=f"one of {', '.join(SCENARIOS)}")
+    r.add_argument("--controllers", default=DEFAULT_CONTROLLERS, metavar="A,B,...",
+                   help=f"comma-separated controller names (default: {DEFAULT_CONTROLLERS})")
+    r.add_argument("--model", metavar="MODEL.json", help="PWARX model file with inputs (valve voltage, pump speed)")
+    r.add_argument("--model-sample-time", type=_positive, default=0.05, metavar="S",
+                   help="the model's sample period in seconds (default 0.05, that of 'hwpts reproduce')")
+    r.add_argument("--hysteresis-width", type=finite_float, default=None, metavar="V",
+                   help="half-width of the valve's play the model's valve input was compensated with [V] "
+                   "(default: read off the sweeps when identifying, else 0.25)")
+    r.add_argument("--setpoint", type=finite_float, default=1000.0, metavar="RPM", help="speed set-point (default 1000)")
+    r.add_argument("--duration", type=_positive, default=None, metavar="S", help="shorter or longer record than the "
+                   "scenario's own (turbulence: 600 s)")
+    r.add_argument("--seed", type=non_negative_int, default=0, metavar="N", help="seed of wind and sensor noise (default 0)")
+    r.add_argument("--out", required=True, metavar="DIR", help="output folder (an earlier run there is replaced)")
+    r.set_defaults(handler=run_command)
+    st = sub.add_parser("study", help="Monte-Carlo study over perturbed plants x wind seeds x controllers on Dask",
+                        description="Run the controllers on perturbed plants (parameters within documented tolerances) "
+                        "and wind seeds, mapped over a Dask cluster: a local one by default, an existing scheduler "
+                        "with --scheduler. Writes DIR/results.parquet (one row per plant, seed and controller) and "
+                        "DIR/summary.json (share of plants on which each controller meets the turbulence targets).")
+    st.add_argument("--plants", type=_count, required=True, metavar="N", help="number of plants (plant 0 is nominal)")
+    st.add_argument("--seeds", type=_count, required=True, metavar="M", help="wind seeds per plant")
+    st.add_argument("--scheduler", metavar="ADDRESS", help="address of a running Dask scheduler, e.g. tcp://127.0.0.1:8786")
+    st.add_argument("--workers", type=_count, default=None, metavar="N", help="workers of the local cluster (default: one per core)")
+    st.add_argument("--scenario", default="turbulence-a", metavar="NAME", help="scenario (default turbulence-a)")
+    st.add_argument("--controllers", default="pi,scheduled,mpc", metavar="A,B,...",
+                    help="controllers (default pi,scheduled,mpc; pi is the baseline of the targets)")
+    st.add_argument("--model", metavar="MODEL.json", help="PWARX model file (default: identified as 'hwpts reproduce' does)")
+    st.add_argument("--model-sample-time", type=_positive, default=0.05, metavar="S", help="the model's sample period (default 0.05 s)")
+    st.add_argument("--hysteresis-width", type=finite_float, default=None, metavar="V", help="the model's play half-width [V]")
+    st.add_argument("--duration", type=_positive, default=None, metavar="S", help="record length (default: the scenario's, 600 s)")
+    st.add_argument("--seed", type=non_negative_int, default=0, metavar="N", help="seed of the plant draws (default 0)")
+    st.add_argument("--out", required=True, metavar="DIR", help="output folder (an earlier study there is replaced)")
+    st.set_defaults(handler=study_command)
+
+
+def identify_model_bank(seed: int, quick: bool = False):
+    """The model bank as 'hwpts reproduce' identifies it (method 'paper'): (model, play half-width)."""
+    import warnings
+
+    from hwpts.experiments import paper
+    from hwpts.experiments.sweeps import estimate_hysteresis, find_fracture, record_sweeps
+    from hwpts.identification import PWARX
+    from hwpts.plant import PlantParameters, TestBed, identification_excitation
+
+    config = paper.ReproduceConfig.quick_run(seed) if quick else paper.ReproduceConfig.full(seed)
+    sweeps = record_sweeps(PlantParameters.paper(), progress=False)
+    r_hat = estimate_hysteresis(sweeps)
+    fracture = find_fracture(sweeps)
+    bed = TestBed(sample_time=config.logger_sample_time_s, noise_std_rpm=config.noise_std_rpm)
+    excitation = identification_excitation(config.identification_duration_s, config.logger_sample_time_s, seed=seed)
+    raw, _ = bed.record(excitation, seed=seed)
+    data = paper.compensate(paper.block_decimate(raw, config.decimation), r_hat)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = PWARX(paper.NA, paper.NB, paper.NK, segmentation="hyperplane",
+                      hyperplanes=paper.paper_hyperplanes(fracture, paper.COMPENSATED_INPUT)).fit(data)
+    return model, float(r_hat), config.sample_time_s
+
+
+def _model_bank(args):
+    """(document, sample time, play half-width, source) from --model or identified as reproduce does."""
+    from hwpts.io.models import load_model, model_to_dict
+
+    if args.hysteresis_width is not None and not 0 <= args.hysteresis_width < 1.3:
+        from hwpts.errors import ParameterError
+
+        raise ParameterError(f"--hysteresis-width: expected a half-width in 0-1.3 V, got {args.hysteresis_width:g}")
+    if args.model:
+        model = load_model(args.model)
+        half_width = 0.25 if args.hysteresis_width is None else args.hysteresis_width
+        return model, model_to_dict(model), args.model_sample_time, half_width, f"file {args.model}"
+    print("identifying the model bank as 'hwpts reproduce' does (method 'paper') ...", file=sys.stderr)
+    model, r_hat, sample_time = identify_model_bank(args.seed)
+    half_width = r_hat if args.hysteresis_width is None else args.hysteresis_width
+    return model, model_to_dict(model), sample_time, half_width, \
+        f"identified on the test bed (method 'paper', seed {args.seed})"
+
+
+STUDY_SCHEMA = "hwpts.control-study/1"
+
+
+def study_command(args) -> int:
+    import json
+    import time
+
+    import numpy as np
+
+    from hwpts.control.controllers import parse_names
+    from hwpts.control.model import ModelBank
+    from hwpts.control.study import PLANT_TOLERANCES, TARGETS, run_study
+    from hwpts.errors import ParameterError
+    from hwpts.io.atomic import write_text_atomic
+    from hwpts.io.datasets import write_table
+    from hwpts.io.folders import check_replaceable, staged_folder
+
+    if args.scenario not in SCENARIOS:
+        raise ParameterError(f"--scenario: unknown scenario {args.scenario!r}; expected one of {', '.join(SCENARIOS)}")
+    names = parse_names(args.controllers)
+    check_replaceable(args.out, STUDY_SCHEMA)
+    start = time.perf_counter()
+    _, doc, sample_time, half_width, source = _model_bank(args)
+    ModelBank(doc, sample_time)  # refuse a model a controller cannot be designed from, before any work
+    result = run_study(doc, sample_time, half_width, args.plants, args.seeds, names, args.scenario, args.seed,
+                       args.scheduler, args.duration, progress=sys.stderr.isatty(), n_workers=args.workers)
+    summary = {"schema": STUDY_SCHEMA, "scenario": args.scenario, "plants": args.plants, "seeds": args.seeds,
+               "seed": args.seed, "controllers": result.summary, "targets": TARGETS,
+               "plant_tolerances": PLANT_TOLERANCES, "model": {"source": source, "sample_time_s": sample_time,
+                                                               "hysteresis_half_width_v": half_width},
+               "scheduler": args.scheduler or "local cluster", "timings_s": {}}
+    best = max(result.summary, key=lambda n: result.summary[n]["plants_meeting_targets_share"] or 0.0)
+    summary["best"] = best
+    with staged_folder(args.out, STUDY_SCHEMA) as stage:
+        cols = {k: [r[k] for r in result.rows] for k in result.rows[0]}
+        cols = {k: (np.asarray(v, dtype=object).astype(str) if k == "controller" else np.asarray(v)) for k, v in cols.items()}
+        write_table(stage / "results.parquet", cols)
+        summary["timings_s"]["total"] = round(time.perf_counter() - start, 1)
+        write_text_atomic(stage / "summary.json", json.dumps(summary, indent=2) + "\n")
+    print(f"{'controller':12s} {'plants meeting targets':>23s} {'runs meeting':>13s} {'median RMS %':>13s} {'worst RMS %':>12s}")
+    for name, s in result.summary.items():
+        print(f"{name:12s} {s['plants_meeting_targets_share'] * 100:22.1f}% {s['runs_meeting_targets_share'] * 100:12.1f}% "
+              f"{s['median_rms_error_percent']:13.3f} {s['worst_rms_error_percent']:12.3f}")
+    print(f"{args.plants} plants x {args.seeds} seeds x {len(names)} controllers on {summary['scheduler']}: "
+          f"wrote {args.out}/results.parquet and summary.json in {summary['timings_s']['total']:.1f} s")
+    return 0
+
+
+def run_command(args) -> int:
+    import json
+    import time
+
+    from tqdm import tqdm
+
+    from hwpts.control.controllers import parse_names
+    from hwpts.control.model import ModelBank
+    from hwpts.control.run import SCHEMA, check_setpoint, run_scenario
+    from hwpts.errors import ParameterError
+    from hwpts.io.atomic import write_bytes_atomic, write_text_atomic
+    from hwpts.io.datasets import write_csv
+    from hwpts.io.folders import check_replaceable, staged_folder
+    from hwpts.io.models import save_model
+    from hwpts.reporting.control import loop_figure, metric_table, render_control_report
+
+    if args.scenario not in SCENARIOS:
+        raise ParameterError(f"--scenario: unknown scenario {args.scenario!r}; expected one of {', '.join(SCENARIOS)}")
+    names = parse_names(args.controllers)
+    check_setpoint(None, args.setpoint)
+    check_replaceable(args.out, SCHEMA)
+    start = time.perf_counter()
+    model, doc, sample_time, half_width, source = _model_bank(args)
+    bank = ModelBank(doc, sample_time)
+    check_setpoint(bank, args.setpoint, doc["training"]["output_range"])
+    with tqdm(total=1000, desc=f"control {args.scenario}", unit="‰", disable=not sys.stderr.isatty(), leave=False) as bar:
+        def progress(fraction, name):
+            bar.set_postfix_str(name)
+            bar.n = int(1000 * fraction)
+            bar.refresh()
+
+        summary, runs, scenario = run_scenario(bank, half_width, args.scenario, names, args.seed, args.setpoint,
+                                               args.duration, source, progress)
+    with staged_folder(args.out, SCHEMA) as stage:
+        for name, result in runs.items():
+            write_csv(stage / "data" / f"{name}.csv", result.columns)
+        cols = {n: r.columns for n, r in runs.items()}
+        figures = {f"{args.scenario}.png": loop_figure(cols, f"{args.scenario}: {scenario.description}")}
+        t_end = scenario.time[-1]
+        if t_end > 60:
+            figures[f"{args.scenario}_zoom.png"] = loop_figure(cols, f"{args.scenario}: 60 s zoom", (t_end / 2 - 30, t_end / 2 + 30))
+        for name, data in figures.items():
+            write_bytes_atomic(stage / "figures" / name, data)
+        if not args.model:
+            save_model(model, stage / "model.json")
+        summary["timings_s"] = {"total": round(time.perf_counter() - start, 2)}
+        write_text_atomic(stage / "report.html", render_control_report(summary, figures))
+        write_text_atomic(stage / "summary.json", json.dumps(summary, indent=2) + "\n")
+    print(metric_table(summary))
+    print(f"best model-based controller: {summary['best']}; wrote {args.out}/: summary.json, report.html, "
+          f"{len(figures)} figures, {len(runs)} data files in {summary['timings_s']['total']:.1f} s")
+    return 0

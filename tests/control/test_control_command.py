@@ -1,0 +1,72 @@
+"""``hwpts control run``: the summary contract, the files, and bad input (exit 2, one line)."""
+
+import json
+
+import pytest
+
+from hwpts.cli import main
+from hwpts.control.metrics import METRIC_NAMES
+
+CONTRACT_KEYS = {"rms_error_percent", "max_error_percent", "within_1_percent_share", "within_0_5_percent_share",
+                 "settling_time_s", "overshoot_percent", "peak_deviation_percent", "recovery_time_s",
+                 "valve_travel_v", "valve_reversals", "mode_switches_per_min", "step_time_ms"}
+
+
+def test_run_writes_the_contract(tmp_path, paper_model_file, paper_model_doc, capsys):
+    out = tmp_path / "run"
+    code = main(["control", "run", "--scenario", "setpoint-step", "--controllers", "pi,scheduled,scheduled-no-inverse",
+                 "--model", str(paper_model_file), "--hysteresis-width", str(paper_model_doc[1]),
+                 "--duration", "8", "--seed", "1", "--out", str(out)])
+    assert code == 0
+    s = json.loads((out / "summary.json").read_text())
+    assert s["schema"] == "hwpts.control/1"
+    assert s["scenario"] == "setpoint-step" and s["seed"] == 1 and s["setpoint_rpm"] == 1000.0
+    assert s["best"] in ("pi", "scheduled", "scheduled-no-inverse")
+    assert set(s["controllers"]) == {"pi", "scheduled", "scheduled-no-inverse"}
+    assert set(METRIC_NAMES) == CONTRACT_KEYS
+    for m in s["controllers"].values():
+        assert set(m) == CONTRACT_KEYS
+        assert set(m["step_time_ms"]) == {"median", "max"}
+        assert m["peak_deviation_percent"] is None  # a disturbance metric: null on a set-point step
+        assert m["settling_time_s"] is not None and m["settling_time_s"] < 2.0
+    assert s["controllers"]["pi"]["mode_switches_per_min"] is None
+    for name in ("pi", "scheduled", "scheduled-no-inverse"):
+        assert (out / "data" / f"{name}.csv").exists()
+    assert (out / "figures" / "setpoint-step.png").exists()
+    html = (out / "report.html").read_text()
+    assert "data:image/png;base64," in html and "http" not in html.split("<body>")[1]
+    assert "RMS error" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("args, expected", [
+    (["--scenario", "gusty"], "--scenario: unknown scenario 'gusty'"),
+    (["--scenario", "pump-step", "--controllers", "pi,fuzzy"], "unknown controller 'fuzzy'"),
+    (["--scenario", "pump-step", "--setpoint", "5000"], "--setpoint: expected a speed in"),
+    (["--scenario", "pump-step", "--setpoint", "nan"], "--setpoint"),
+    (["--scenario", "pump-step", "--seed", "-1"], "--seed"),
+])
+def test_bad_arguments_exit_2_with_one_line(tmp_path, capsys, paper_model_file, args, expected):
+    out = tmp_path / "o"
+    code = main(["control", "run", *args, "--model", str(paper_model_file), "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert err.count("\n") == 1 and err.startswith("hwpts: error: ")
+    assert expected in err
+    assert not out.exists()
+
+
+def test_model_whose_inputs_are_not_valve_and_pump(tmp_path, capsys, paper_model_doc):
+    import numpy as np
+
+    from hwpts.identification import PWARX
+    from hwpts.io.models import save_model
+
+    rng = np.random.default_rng(0)
+    u = rng.uniform(size=(200, 2))
+    y = u @ [1.0, 2.0] + 0.01 * rng.standard_normal(200)
+    path = tmp_path / "other.json"
+    save_model(PWARX(1, 1, 1, segmentation="average").fit(u, y, input_names=["force", "current"]), path)
+    code = main(["control", "run", "--scenario", "pump-step", "--model", str(path), "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1
+    assert "inputs must be the valve voltage and the pump speed" in err and "force" in err

@@ -1,0 +1,78 @@
+"""``hwpts control study`` on Dask: a local cluster, and a scheduler + worker started on the loopback."""
+
+import json
+import subprocess
+import sys
+import time
+
+import pytest
+
+from hwpts.cli import main
+
+pytest.importorskip("distributed")
+
+
+def _study(tmp_path, model_file, *extra):
+    out = tmp_path / "study"
+    code = main(["control", "study", "--plants", "2", "--seeds", "1", "--duration", "8", "--controllers", "pi,scheduled",
+                 "--model", str(model_file), "--out", str(out), *extra])
+    assert code == 0
+    summary = json.loads((out / "summary.json").read_text())
+    import pyarrow.parquet as pq
+
+    table = pq.read_table(out / "results.parquet").to_pydict()
+    return summary, table
+
+
+def _check(summary, table):
+    assert summary["schema"] == "hwpts.control-study/1"
+    assert set(summary["controllers"]) == {"pi", "scheduled"}
+    assert len(table["controller"]) == 2 * 1 * 2
+    assert sorted(set(table["plant"])) == [0, 1]
+    for s in summary["controllers"].values():
+        assert 0.0 <= s["plants_meeting_targets_share"] <= 1.0
+
+
+@pytest.mark.slow
+def test_study_on_a_local_cluster(tmp_path, paper_model_file):
+    summary, table = _study(tmp_path, paper_model_file, "--workers", "2")
+    _check(summary, table)
+    assert summary["scheduler"] == "local cluster"
+
+
+@pytest.mark.slow
+def test_study_through_a_scheduler_on_the_loopback(tmp_path, paper_model_file):
+    file = tmp_path / "scheduler.json"
+    scheduler = subprocess.Popen([sys.executable, "-m", "dask", "scheduler", "--host", "127.0.0.1", "--port", "0",
+                                  "--no-dashboard", "--scheduler-file", str(file)],
+                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    worker = None
+    try:
+        for _ in range(200):
+            if file.exists() and file.stat().st_size:
+                break
+            time.sleep(0.1)
+        address = json.loads(file.read_text())["address"]
+        assert address.startswith("tcp://127.0.0.1:")
+        worker = subprocess.Popen([sys.executable, "-m", "dask", "worker", "--scheduler-file", str(file),
+                                   "--nworkers", "1", "--nthreads", "1", "--no-dashboard"],
+                                  stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        summary, table = _study(tmp_path, paper_model_file, "--scheduler", address)
+        _check(summary, table)
+        assert summary["scheduler"] == address
+    finally:
+        for proc in (worker, scheduler):
+            if proc is not None:
+                proc.terminate()
+                try:
+                    proc.wait(timeout=10)
+                except subprocess.TimeoutExpired:
+                    proc.kill()
+
+
+def test_unreachable_scheduler_is_one_line(tmp_path, capsys, paper_model_file, monkeypatch):
+    monkeypatch.setattr("hwpts.control.study.CONNECT_TIMEOUT_S", 1.0)
+    code = main(["control", "study", "--plants", "1", "--seeds", "1", "--duration", "5", "--controllers", "pi",
+                 "--model", str(paper_model_file), "--scheduler", "tcp://127.0.0.1:9", "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and "--scheduler" in err
