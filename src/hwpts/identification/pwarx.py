@@ -89,6 +89,11 @@ class PWARX(BaseEstimator):
         that depend on a few signals (the paper's fracture line: valve voltage and pump speed) are
         then estimated in that subspace, where the data are dense, instead of carrying noise in
         every other direction.
+    max_rows : int or None
+        Learned partitions (clustering, alternating, k-means...) are found on at most this many
+        regressor rows drawn at random (seeded); the local least squares then use every row.
+        Segmentation and boundary refinement cost grows with the rows, the boundaries' accuracy
+        hardly beyond a few thousand (default 5,000; ``None``: all rows).
     polish : bool
         Refine the local parameters by minimising the free-run simulation error on the training
         data (partition fixed; see :mod:`hwpts.identification.polish`), kept only if better.
@@ -115,7 +120,8 @@ class PWARX(BaseEstimator):
     def __init__(self, output_order=1, input_order=1, input_delay=1, n_regions=2,
                  segmentation="clustering", hyperplanes=None, region_models=None, constant=True,
                  ridge=0.0, refinement_rounds=3, classifier_C=1e4, segmentation_params=None,
-                 polish=False, partition_columns=None, sparse_partition=True, random_state=None):
+                 polish=False, partition_columns=None, sparse_partition=True, max_rows=5000,
+                 random_state=None):
         self.output_order = output_order
         self.input_order = input_order
         self.input_delay = input_delay
@@ -131,6 +137,7 @@ class PWARX(BaseEstimator):
         self.polish = polish
         self.partition_columns = partition_columns
         self.sparse_partition = sparse_partition
+        self.max_rows = max_rows
         self.random_state = random_state
 
     # ------------------------------------------------------------------ fitting
@@ -213,7 +220,14 @@ class PWARX(BaseEstimator):
         if segmenter.uses_n_regions:
             if not isinstance(n_regions, (int, np.integer)) or isinstance(n_regions, bool) or n_regions < 1:
                 raise ParameterError(f"n_regions must be an int >= 1 for {self.segmentation!r}, got {n_regions!r}")
-        seg = segmenter.segment(X_reg, target, n_regions, structure, rng)
+        X_seg, y_seg = X_reg, target
+        limit = self.max_rows
+        if limit is not None and (isinstance(limit, bool) or not isinstance(limit, (int, np.integer)) or limit < 100):
+            raise ParameterError(f"max_rows must be None or an int >= 100, got {limit!r}")
+        if segmenter.learns_partition and limit is not None and X_reg.shape[0] > limit:
+            rows = np.sort(rng.choice(X_reg.shape[0], int(limit), replace=False))
+            X_seg, y_seg = X_reg[rows], target[rows]
+        seg = segmenter.segment(X_seg, y_seg, n_regions, structure, rng)
         s = seg.n_regions
         kinds = self._kinds(s)
         sparse_columns = None
@@ -221,9 +235,14 @@ class PWARX(BaseEstimator):
             partition = seg.partition
             labels = partition.predict(X_reg)
         else:
-            labels, partition, sparse_columns = self._learn_partition(X_reg, target, seg.labels, s, kinds,
-                                                                      seg.refine, structure)
-            s = partition.n_regions
+            _, partition, sparse_columns = self._learn_partition(X_seg, y_seg, seg.labels, s, kinds,
+                                                                 seg.refine, structure)
+            labels = partition.predict(X_reg)
+            labels, s = self._drop_empty(labels, partition.n_regions)
+            if s != partition.n_regions:
+                partition = fit_linear_partition(X_reg, labels, s, C=self.classifier_C,
+                                                 columns=self._pcols if sparse_columns is None else sparse_columns)
+                labels = partition.predict(X_reg)
             kinds = self._kinds(s)
         learned = seg.partition is None and s > 1
         local = fit_local_models(X_reg, target, labels, s, structure.constant, kinds, self.ridge,
