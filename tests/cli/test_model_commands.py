@@ -190,3 +190,36 @@ def test_diverging_free_run_writes_no_file(tmp_path, data_csv, capsys):
     assert result["diverged"] is True and result["fit_percent"] is None and "left the band" in result["reason"]
     out = tmp_path / "p.csv"
     _expect_error(capsys, ["predict", str(path), str(data_csv), "--out", str(out)], "no file written", out)
+
+
+def test_identify_chooses_the_orders_and_says_why(tmp_path, capsys):
+    """Without --na/--nb/--nk the orders are chosen on the data: an ARX [2 2 1] system is recognised."""
+    rng = np.random.default_rng(0)
+    u = rng.standard_normal(1500)
+    y = np.zeros(1500)
+    for k in range(2, 1500):
+        y[k] = 1.5 * y[k - 1] - 0.7 * y[k - 2] + u[k - 1] + 0.5 * u[k - 2] + 0.05 * rng.standard_normal()
+    path = tmp_path / "arx.csv"
+    write_csv(path, {"u": u, "y": y})
+    out = tmp_path / "m.json"
+    assert main(["identify", str(path), "--input", "u", "--output", "y", "--segmentation", "average",
+                 "--out", str(out)]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    choice = summary["choice"]
+    assert (choice["na"], choice["nb"], choice["nk"]) == (2, [2], [1])
+    assert "held-out blocks" in choice["why"] and choice["n_candidates"] == len(summary["candidates"]) == 40
+    assert sum(bool(r.get("chosen")) for r in summary["candidates"]) == 1
+
+
+def test_search_bad_inputs_give_one_line(tmp_path, data_csv, capsys):
+    path = tmp_path / "short.csv"
+    rng = np.random.default_rng(0)
+    write_csv(path, {"a": rng.random(25), "y": rng.random(25)})
+    out = tmp_path / "m.json"
+    _expect_error(capsys, ["identify", str(path), "--input", "a", "--output", "y", "--out", str(out)],
+                  "25 samples are too few to choose a model", out)
+    short = tmp_path / "s300.csv"
+    d = make_system(5, rng=0, n=300)
+    write_csv(short, {"u1": d.inputs[:, 0], "u2": d.inputs[:, 1], "y": d.output})
+    _expect_error(capsys, ["identify", str(short), *IDENTIFY, "--segmentation", "alternating", "--regions", "50",
+                           "--out", str(out)], "n_regions=50 is too many for 298 regressor rows", out)

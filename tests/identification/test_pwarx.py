@@ -109,32 +109,27 @@ def test_free_run_of_one_million_samples_stays_bounded():
     assert np.all(np.isin(sim.regions[2:], [0, 1, 2]))
 
 
-def test_auto_rejects_divergence_and_reports_candidates():
+def test_search_reports_candidates_and_chooses_the_structure():
+    """The default model search on system 5 (2,000 samples): one chosen row, three regions found."""
+    from hwpts.identification import PWARXSearch
+
     d = make_system(5, rng=1, n=2000)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        m = PWARX(2, 2, 1, n_regions=3, segmentation="auto", random_state=0).fit(d.inputs, d.output)
-    assert m.selection_ and sum(bool(r.get("chosen")) for r in m.selection_) == 1
-    chosen = next(r for r in m.selection_ if r.get("chosen"))
-    assert chosen["rejected"] is None and chosen["segmentation"] in ("clustering", "alternating")
-    assert m.n_regions_ == 3
+    search = PWARXSearch(PWARX(2, 2, 1, random_state=0), max_regions=4).fit(d.inputs, d.output)
+    table = search.cv_results_
+    assert sum(bool(r.get("chosen")) for r in table) == 1
+    chosen = next(r for r in table if r.get("chosen"))
+    assert chosen["mean_fit_percent"] == search.best_score_ and chosen["error"] is None
+    assert search.best_estimator_.n_regions_ == 3
+    assert sorted(r["rank"] for r in table) == list(range(1, len(table) + 1))
     v = make_system(5, rng=5, n=3000, sigma=0.0)
-    assert fit_percent(v.output[2:], m.simulate(v.inputs, v.output).output[2:]) > 80
-    # the chosen structure is also scored with the simulation-error polish, on the same blocks
-    polish_rows = [r for r in m.selection_ if r.get("polish")]
-    assert len(polish_rows) == 1 and polish_rows[0]["segmentation"] == chosen["segmentation"]
-    assert m.summary()["polished"] == bool(polish_rows[0].get("chosen"))
+    assert fit_percent(v.output[2:], search.simulate(v.inputs, v.output).output[2:]) > 80
 
 
-def test_auto_parameters_are_its_own():
-    """segmentation_params of auto (here: no polish trial, one held-out block at the end) are not
-    passed on to the candidate methods (they used to make every candidate fail)."""
+def test_pwarx_is_one_model():
+    """'auto' is not a segmentation: PWARX never selects among models."""
     d = make_system(5, rng=1, n=600)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        m = PWARX(2, 2, 1, n_regions=2, segmentation="auto", random_state=0,
-                  segmentation_params={"try_polish": False, "scheme": "tail"}).fit(d.inputs, d.output)
-    assert not any(r.get("polish") for r in m.selection_) and m.summary()["polished"] is False
+    with pytest.raises(ParameterError, match="PWARXSearch"):
+        PWARX(2, 2, 1, segmentation="auto").fit(d.inputs, d.output)
 
 
 def _static_switch(slope, n=4000, seed=0):

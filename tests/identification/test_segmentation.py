@@ -19,9 +19,33 @@ from hwpts.identification.synthetic import make_system
 
 def test_registry_names_and_unknown_name_lists_them():
     assert set(SEGMENTATION_METHODS) == {"average", "zscore", "kmeans", "hyperplane", "clustering",
-                                         "alternating", "threshold", "auto"}
+                                         "alternating", "threshold"}
     with pytest.raises(ParameterError, match=r"unknown segmentation 'nope'; valid methods are \['alternating'"):
         make_segmenter("nope")
+
+
+@pytest.mark.parametrize("name", sorted(SEGMENTATION_METHODS))
+def test_segmenters_and_estimators_are_cloneable(name):
+    """Segmenters are scikit-learn estimators: keyword-only, cloneable with the model that holds
+    them, and a clone fits exactly as the original."""
+    from sklearn.base import clone
+
+    from hwpts.identification import PWARXSearch
+
+    params = {"hyperplanes": ["1,0,-0.2"]} if name == "hyperplane" else {}
+    segmenter = make_segmenter(name, **params)
+    assert clone(segmenter).get_params() == segmenter.get_params()
+    with pytest.raises(TypeError):
+        type(segmenter)(0.5)  # parameters are keyword-only
+    d = make_system(5, rng=0, n=600)  # two inputs (the hyperplane "a,b,c" is on the first two)
+    model = PWARX(d.na, d.nb, d.nk, n_regions=2, segmentation=segmenter, random_state=0)
+    twin = clone(model)
+    assert twin.segmentation is not model.segmentation
+    a = model.fit(d.inputs, d.output)
+    b = twin.fit(d.inputs, d.output)
+    np.testing.assert_array_equal(a.theta_, b.theta_)
+    search = clone(PWARXSearch(model, [{"n_regions": 2}]))
+    assert search.estimator.segmentation.get_params() == segmenter.get_params()
 
 
 def test_paper_space_line_projects_to_eq16():

@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 
 from hwpts.errors import ParameterError
-from hwpts.identification import PWARX
+from hwpts.identification import PWARX, PWARXSearch
 from hwpts.identification.metrics import fit_percent
 from hwpts.identification.segmentation.threshold import threshold_partition
-from hwpts.identification.selection import expand_grid, select_model
+from hwpts.identification.selection import expand_grid
 
 
 def setar(n, seed, threshold=0.3, sigma=0.01):
@@ -44,11 +44,51 @@ def test_threshold_three_regions_and_bad_parameters():
     m = PWARX(2, 2, 1, n_regions=3, segmentation="threshold").fit(u, y)
     t = m.segmentation_info_["thresholds"]
     assert len(t) == 2 and t[0] < t[1] and m.n_regions_ == 3
-    assert np.all(m.region_counts_ >= 0.05 * (len(y) - 2))
-    with pytest.raises(ParameterError, match="1 to 3 regions"):
-        PWARX(1, 1, 1, n_regions=4, segmentation="threshold").fit(u, y)
+    assert np.all(m.region_counts_ >= 0.03 * (len(y) - 2))
+    with pytest.raises(ParameterError, match="min_share"):
+        PWARX(1, 1, 1, n_regions=40, segmentation="threshold").fit(u, y)
     with pytest.raises(ParameterError, match="unknown regressor column"):
         PWARX(1, 1, 1, segmentation="threshold", segmentation_params={"column": "y(k-3)"}).fit(u, y)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_dynamic_programme_is_the_exhaustive_optimum(seed):
+    """The dynamic programme over sorted rows returns the least-squares optimum of every split
+    into s intervals (checked against brute force over all cut triples on 40 rows)."""
+    import itertools
+
+    from hwpts.identification.segmentation.threshold import optimal_split
+
+    rng = np.random.default_rng(seed)
+    x = rng.uniform(-3, 3, 40)
+    Phi = np.column_stack([x, np.ones_like(x)])
+    y = np.where(x < -1, x, np.where(x < 1, -x + 1, 0.5 * x)) + 0.1 * rng.standard_normal(40)
+    sse, thresholds = optimal_split(x, Phi, y, 4, min_rows=3)
+    order = np.argsort(x)
+    xs, P, ys = x[order], Phi[order], y[order]
+
+    def block(a, b):
+        theta = np.linalg.lstsq(P[a:b], ys[a:b], rcond=None)[0]
+        return float(np.sum((ys[a:b] - P[a:b] @ theta) ** 2))
+
+    brute = min(sum(block(a, b) for a, b in zip((0, *cuts), (*cuts, 40)))
+                for cuts in itertools.combinations(range(3, 38), 3)
+                if all(b - a >= 3 for a, b in zip((0, *cuts), (*cuts, 40))))
+    assert sse == pytest.approx(brute, rel=1e-5)  # (a 1e-10 ridge)
+    assert len(thresholds) == 3 and np.all(np.diff(thresholds) > 0)
+
+
+def test_threshold_column_chosen_among_all_columns():
+    """``column=None``: the switching variable is found among the regressors (here u1(k-1))."""
+    rng = np.random.default_rng(3)
+    u = rng.uniform(-1, 1, (600, 2))
+    y = np.zeros(600)
+    for k in range(1, 600):
+        y[k] = (0.5 * y[k - 1] + u[k - 1, 1] if u[k - 1, 0] <= 0.2 else -0.3 * y[k - 1] + 1.0) \
+            + 0.01 * rng.standard_normal()
+    m = PWARX(1, 1, 1, n_regions=2, segmentation="threshold", segmentation_params={"column": None}).fit(u, y)
+    assert m.segmentation_info_["column"] == "u1(k-1)"
+    assert abs(m.segmentation_info_["thresholds"][0] - 0.2) < 0.02
 
 
 def test_threshold_partition_regions():
@@ -61,13 +101,30 @@ def test_blocked_selection_covers_the_record_and_parallel_matches_sequential():
     u, y = setar(1500, 3)
     grid = expand_grid({"output_order": [1], "input_order": [1], "segmentation": ["average", "threshold"],
                         "n_regions": [2]})
-    model, table = select_model(u, y, grid, n_folds=3, scheme="blocked")
+    search = PWARXSearch(PWARX(random_state=0), grid, cv=3, try_polish=False).fit(u, y)
+    table = search.cv_results_
     chosen = next(r for r in table if r.get("chosen"))
-    assert chosen["params"]["segmentation"] == "threshold" and len(chosen["fits"]) == 3
-    assert model.n_regions_ == 2
-    _, table2 = select_model(u, y, grid, n_folds=3, scheme="blocked", n_jobs=2)
-    assert [r["fits"] for r in table] == [r["fits"] for r in table2]
-    with pytest.raises(ParameterError, match="unknown scheme"):
-        select_model(u, y, grid, scheme="kfold")
-    with pytest.raises(ParameterError, match="cannot make"):
-        select_model(u, y, grid, n_folds=1, scheme="blocked")
+    assert chosen["params"]["segmentation"] == "threshold" and len(chosen["split_fits_percent"]) == 3
+    assert search.best_estimator_.n_regions_ == 2
+    again = PWARXSearch(PWARX(random_state=0), grid, cv=3, try_polish=False, n_jobs=2).fit(u, y)
+    assert [r["split_fits_percent"] for r in table] == [r["split_fits_percent"] for r in again.cv_results_]
+    with pytest.raises(ParameterError, match="n_splits"):
+        PWARXSearch(PWARX(), grid, cv=1).fit(u, y)
+    with pytest.raises(ParameterError, match="nothing to try"):
+        PWARXSearch(PWARX(), []).fit(u, y)
+
+
+def test_blocked_split_drops_the_regressor_rows_spanning_the_gap():
+    """The training part of an inner block joins two stretches: the search passes the break, and
+    the fit drops the max_lag regressor rows that mix samples from both sides."""
+    from hwpts.identification.selection import BlockedSplit, breaks_of
+
+    splits = list(BlockedSplit(3).split(np.zeros((30, 1))))
+    train, test = splits[1]
+    assert list(test) == list(range(10, 20)) and breaks_of(train) == [10]
+    u, y = setar(600, 4)
+    joined = np.concatenate([y[:300], y[300:] + 50.0])  # a jump at the junction
+    clean = PWARX(1, 1, 1, n_regions=1, segmentation="average").fit(u, joined, breaks=[300])
+    dirty = PWARX(1, 1, 1, n_regions=1, segmentation="average").fit(u, joined)
+    # with the break, the junction row is gone; without it, it pulls the least squares
+    assert clean.region_counts_[0] == dirty.region_counts_[0] - 1

@@ -57,7 +57,7 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
     return IODataset.from_columns(cols, list(input_names), output_name, time_name=tname)
 
 
-def _fit_summary(model, data, path, out, elapsed):
+def _fit_summary(model, data, path, out, elapsed, search=None):
     from hwpts.identification.metrics import fit_percent, rmse
 
     m = model.structure_.max_lag
@@ -72,25 +72,54 @@ def _fit_summary(model, data, path, out, elapsed):
     if sim.diverged:
         summary["diverged"] = True
         summary["reason"] = sim.reason
-    if model.selection_:
-        summary["candidates"] = [
-            {k: (round(v, 3) if isinstance(v, float) else v) for k, v in row.items()} for row in model.selection_
-        ]
+    if search is not None:
+        table = search.candidate_table()
+        summary["choice"] = {
+            "na": model.structure_.na, "nb": list(model.structure_.nb), "nk": list(model.structure_.nk),
+            "segmentation": summary["segmentation"], "n_regions": int(model.n_regions_),
+            "polished": summary["polished"], "heldout_fit_percent": round(search.best_score_, 3),
+            "n_candidates": len(table), "n_blocks": search.n_splits_,
+            "why": (f"best mean free-run fit over {search.n_splits_} held-out blocks of the training data "
+                    f"({len(table)} candidates; within {search.tolerance} points the fewest regions, then the "
+                    f"fewest parameters, win)"),
+        }
+        summary["candidates"] = table
     summary["fit_time_s"] = round(elapsed, 3)
     return summary
 
 
+def _orders_to_search(args):
+    """The estimator's orders and the order grid of the search: the orders not given are searched
+    (``--nk`` defaults to 1 when ``--na`` and ``--nb`` are both given, as before)."""
+    from hwpts.identification.selection import ORDER_GRID
+
+    given = {"output_order": args.na,
+             "input_order": None if args.nb is None else _int_list(args.nb, "nb"),
+             "input_delay": None if args.nk is None else _int_list(args.nk, "nk")}
+    if given["output_order"] is not None and given["input_order"] is not None and given["input_delay"] is None:
+        given["input_delay"] = 1
+    for key, flag in (("output_order", "--na"), ("input_order", "--nb"), ("input_delay", "--nk")):
+        values = given[key] if isinstance(given[key], list) else [given[key]]
+        if given[key] is not None and any(v < 0 for v in values):
+            raise ParameterError(f"{flag} expects ints >= 0, got {given[key]!r}")
+    searched = {k: list(ORDER_GRID[k]) for k, v in given.items() if v is None}
+    fixed = {k: v for k, v in given.items() if v is not None}
+    return fixed, searched
+
+
 def cmd_identify(args) -> int:
-    from hwpts.identification import PWARX
+    from hwpts.identification import PWARX, PWARXSearch
     from hwpts.identification.partition import Hyperplane
     from hwpts.identification.regressors import RegressorStructure
+    from hwpts.identification.selection import DEFAULT_METHODS
     from hwpts.io.models import save_model
 
     data = _load_dataset(args.data, args.input, args.output, args.time, args.rows)
-    nb = _int_list(args.nb, "nb")
-    nk = _int_list(args.nk, "nk")
-    structure = RegressorStructure.create(args.na, nb, nk, len(args.input), True, args.input, args.output)
-    structure.check_length(data.n_samples, what=f"{args.data!s}")
+    fixed, searched = _orders_to_search(args)
+    if not searched:
+        structure = RegressorStructure.create(fixed["output_order"], fixed["input_order"], fixed["input_delay"],
+                                              len(args.input), True, args.input, args.output)
+        structure.check_length(data.n_samples, what=f"{args.data!s}")
     hyperplanes = [Hyperplane.parse(h) for h in args.hyperplane]
     segmentation = args.segmentation
     if hyperplanes and segmentation is None:
@@ -102,7 +131,7 @@ def cmd_identify(args) -> int:
         raise ParameterError(f"--hyperplane needs --segmentation hyperplane, not {segmentation!r}")
     regions = args.regions
     if regions == "auto":
-        n_regions = "auto" if segmentation == "auto" else 2
+        n_regions = "auto"
     else:
         try:
             n_regions = int(regions)
@@ -120,18 +149,36 @@ def cmd_identify(args) -> int:
             if not 1 <= r <= n_hyper:
                 raise ParameterError(f"--zero-region {r}: regions are numbered 1..{n_hyper}")
             region_models[r - 1] = "zero"
+    fixed_partition = segmentation in ("hyperplane", "average", "zscore")
     model = PWARX(
-        output_order=args.na, input_order=nb, input_delay=nk, n_regions=n_regions,
-        segmentation=segmentation, hyperplanes=hyperplanes or None, region_models=region_models,
+        **{"output_order": 1, "input_order": 1, "input_delay": 1, **fixed},
+        n_regions=n_regions if isinstance(n_regions, int) else 2,
+        segmentation=segmentation if segmentation != "auto" else "clustering",
+        hyperplanes=hyperplanes or None, region_models=region_models,
         ridge=args.ridge, polish=args.polish, random_state=args.seed,
         partition_columns=args.partition_column or None, sparse_partition=not args.all_partition_columns,
     )
+    search = None
+    if searched or (n_regions == "auto" and not fixed_partition):
+        if segmentation == "auto" or n_regions == "auto" and not fixed_partition:
+            methods = DEFAULT_METHODS if segmentation == "auto" else (segmentation,)
+            search = PWARXSearch(model, methods=methods, orders=searched or None, progress=True,
+                                 try_polish="auto" if not args.polish else False,
+                                 max_regions=n_regions if isinstance(n_regions, int) else "auto")
+            if isinstance(n_regions, int):  # a fixed method and count, the orders searched
+                search.set_params(param_grid={**searched, "segmentation": [segmentation], "n_regions": [n_regions]})
+        else:
+            search = PWARXSearch(model, param_grid=dict(searched), progress=True, try_polish=False)
     t0 = time.perf_counter()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        model.fit(data.inputs, data.output, input_names=args.input, output_name=args.output)
+        if search is not None:
+            search.fit(data.inputs, data.output, input_names=args.input, output_name=args.output)
+            model = search.best_estimator_
+        else:
+            model.fit(data.inputs, data.output, input_names=args.input, output_name=args.output)
     elapsed = time.perf_counter() - t0
-    summary = _fit_summary(model, data, args.data, args.out, elapsed)
+    summary = _fit_summary(model, data, args.data, args.out, elapsed, search)
     notes = sorted({str(w.message) for w in caught if issubclass(w.category, UserWarning)})
     if notes:
         summary["warnings"] = notes
@@ -238,13 +285,17 @@ def register(subparsers):
     p.add_argument("data", metavar="DATA", help="data file: .csv, .parquet or .mat")
     p.add_argument("--input", metavar="COL", action="append", required=True, help="input column (repeat for several)")
     p.add_argument("--output", metavar="COL", required=True, help="output column")
-    p.add_argument("--na", type=int, required=True, metavar="N", help="output order")
-    p.add_argument("--nb", required=True, metavar="N", help="input order (an int, or one per input: 4,4)")
-    p.add_argument("--nk", default="1", metavar="N", help="input delay (default 1; 0 uses u(k))")
-    p.add_argument("--segmentation", choices=sorted(SEGMENTATION_METHODS), default=None,
-                   help="segmentation method (default auto, or hyperplane when --hyperplane is given)")
+    p.add_argument("--na", type=int, default=None, metavar="N",
+                   help="output order (default: chosen on the data, 0-4)")
+    p.add_argument("--nb", default=None, metavar="N",
+                   help="input order, an int or one per input: 4,4 (default: chosen on the data, 1-4)")
+    p.add_argument("--nk", default=None, metavar="N",
+                   help="input delay, 0 uses u(k) (default: chosen on the data, 0-1; 1 when --na and --nb are given)")
+    p.add_argument("--segmentation", choices=["auto", *sorted(SEGMENTATION_METHODS)], default=None,
+                   help="segmentation method (default auto: chosen on the data among threshold, clustering and "
+                        "alternating; hyperplane when --hyperplane is given)")
     p.add_argument("--regions", default="auto", metavar="S",
-                   help="number of regions (for auto: the most tried; default auto)")
+                   help="number of regions (default auto: grown while the held-out fit improves)")
     p.add_argument("--hyperplane", action="append", default=[], metavar='"a,b,c"',
                    help="a*x1 + b*x2 + c >= 0 on the first two inputs, or 'a,b,c@col1,col2' on named "
                         "regressor columns; repeat for a decision list (m hyperplanes, m+1 regions)")

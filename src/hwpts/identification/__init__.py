@@ -6,7 +6,8 @@ This package never imports :mod:`hwpts.plant`.
 - :mod:`.segmentation`: the methods, one per file, chosen by name;
 - :mod:`.partition`: polyhedral partitions (eq. 9) and the region classifier;
 - :mod:`.local_models`: least squares per region (eq. 17);
-- :mod:`.pwarx`: the estimator; :mod:`.simulation`: the switching-rule free run;
+- :mod:`.pwarx`: the estimator (one model); :mod:`.selection`: the model search wrapping it
+  (:class:`PWARXSearch`) and time-series splitters; :mod:`.simulation`: the switching-rule free run;
 - :mod:`.statespace`: state-space form of each mode (eq. 7); :mod:`.metrics`: fit %, accuracy.
 """
 
@@ -16,10 +17,11 @@ from hwpts.identification.partition import Hyperplane, RegionPartition
 from hwpts.identification.pwarx import PWARX, FreeRunDivergedWarning
 from hwpts.identification.regressors import RegressorStructure
 from hwpts.identification.segmentation import SEGMENTATION_METHODS, make_segmenter
+from hwpts.identification.selection import BlockedSplit, HoldoutSplit, PWARXSearch
 from hwpts.identification.simulation import SimulationResult
 
 __all__ = [
-    "PWARX", "RegressorStructure", "RegionPartition", "Hyperplane", "SimulationResult",
+    "PWARX", "PWARXSearch", "BlockedSplit", "HoldoutSplit", "RegressorStructure", "RegionPartition", "Hyperplane", "SimulationResult",
     "SEGMENTATION_METHODS", "make_segmenter", "RegionWarning", "FreeRunDivergedWarning",
     "fit_percent", "rmse", "region_accuracy", "parameter_error",
 ]

@@ -26,10 +26,9 @@ from sklearn.utils.validation import check_is_fitted
 from hwpts.dataset import IODataset
 from hwpts.errors import DataError, IdentificationError, ParameterError
 from hwpts.identification.local_models import MODEL_KINDS, RegionWarning, fit_local_models
-from hwpts.identification.metrics import fit_percent
 from hwpts.identification.partition import RegionPartition, fit_linear_partition
 from hwpts.identification.regressors import RegressorStructure, validate_signals
-from hwpts.identification.segmentation import AutoSegmenter, make_segmenter
+from hwpts.identification.segmentation import make_segmenter
 from hwpts.identification.simulation import SimulationResult, one_step_pwarx, simulate_pwarx
 from hwpts.identification.statespace import mode_state_space
 
@@ -57,11 +56,13 @@ class PWARX(BaseEstimator):
         ``nb`` per input (samples of each input in the regressor).
     input_delay : int or list of int
         ``nk`` per input; ``0`` uses ``u(k)`` as the paper's eq. 18.
-    n_regions : int or "auto"
-        Number of regions ``s`` (ignored by ``average``, ``zscore``, ``hyperplane``; the largest
-        number tried by ``auto``).
-    segmentation : str
-        A name from :data:`hwpts.identification.segmentation.SEGMENTATION_METHODS`.
+    n_regions : int
+        Number of regions ``s`` (ignored by ``average``, ``zscore``, ``hyperplane``). A PWARX is
+        one model: to choose the number of regions, the method or the orders from the data, wrap
+        it in :class:`hwpts.identification.PWARXSearch` (what ``hwpts identify`` does by default).
+    segmentation : str or Segmenter
+        A name from :data:`hwpts.identification.segmentation.SEGMENTATION_METHODS`, or a segmenter
+        instance (a scikit-learn estimator: cloned with the model).
     hyperplanes : sequence of str or Hyperplane, optional
         For ``segmentation="hyperplane"``: ``"a,b,c"`` = ``a*x1 + b*x2 + c >= 0`` on the first
         two inputs, or ``"a,b,c@col1,col2"`` on named regressor/input columns.
@@ -109,8 +110,6 @@ class PWARX(BaseEstimator):
     output_range_ : (float, float)
     input_ranges_ : ndarray, shape (n_inputs, 2)
     segmentation_info_ : dict
-    selection_ : list of dict
-        The candidate table of ``segmentation="auto"`` (empty otherwise).
     """
 
     def __init__(self, output_order=1, input_order=1, input_delay=1, n_regions=2,
@@ -146,6 +145,17 @@ class PWARX(BaseEstimator):
         return u, yy, names, output_name
 
     def _segmenter(self):
+        from sklearn.base import clone
+
+        from hwpts.identification.segmentation.base import Segmenter
+
+        if isinstance(self.segmentation, Segmenter):
+            if self.segmentation_params:
+                return clone(self.segmentation).set_params(**self.segmentation_params)
+            return clone(self.segmentation)
+        if self.segmentation == "auto":
+            raise ParameterError("segmentation 'auto' is a model search, not a model: use "
+                                 "PWARXSearch(PWARX(...)) (what `hwpts identify` does by default)")
         params = dict(self.segmentation_params or {})
         if self.segmentation == "hyperplane":
             params.setdefault("hyperplanes", tuple(self.hyperplanes or ()))
@@ -156,9 +166,11 @@ class PWARX(BaseEstimator):
             )
         return make_segmenter(self.segmentation, **params)
 
-    def fit(self, X, y=None, input_names=None, output_name=None):
+    def fit(self, X, y=None, input_names=None, output_name=None, breaks=None):
         """Identify the model from inputs ``X`` (n, n_inputs) and output ``y`` (n,), or an IODataset.
 
+        ``breaks``: sample positions where the record restarts (several experiments joined, or the
+        two sides of a held-out block); regressor rows whose lags span a break are dropped.
         Returns ``self``.
         """
         u, yy, names, oname = self._signals(X, y, input_names, output_name)
@@ -178,22 +190,25 @@ class PWARX(BaseEstimator):
                             f"there is nothing to identify")
         segmenter = self._segmenter()
         rng = np.random.default_rng(self.random_state)
-        self.selection_ = []
-        if isinstance(segmenter, AutoSegmenter):
-            chosen, table = segmenter.select(self, u, yy)
-            self.selection_ = table
-            best = self.__class__(**{**self.get_params(), **chosen})
-            best.fit(u, yy, names, oname)
-            for key, value in vars(best).items():
-                if key.endswith("_") and key != "selection_":
-                    setattr(self, key, value)
-            self.segmentation_info_ = {**best.segmentation_info_, "auto": chosen}
-            return self
-
         X_reg, target = structure.build(u, yy)
+        if breaks:
+            keep = np.ones(target.shape[0], dtype=bool)
+            m = structure.max_lag
+            for b in breaks:  # rows k in [b, b + m) use samples from both sides of the break
+                keep[max(int(b) - m, 0):max(int(b), 0)] = False
+            X_reg, target = X_reg[keep], target[keep]
+            if target.shape[0] <= structure.n_features + 1:
+                raise DataError(f"{target.shape[0]} regressor rows are left after the breaks {list(breaks)}: "
+                                f"too few to fit")
         self._pcols = None
         if self.partition_columns is not None:
             self._pcols = sorted({structure.column_index(c) for c in self.partition_columns})
+        if segmenter.uses_n_regions and isinstance(self.n_regions, (int, np.integer)) \
+                and not isinstance(self.n_regions, bool) and self.n_regions > X_reg.shape[0] // (structure.n_features + 2):
+            raise ParameterError(
+                f"n_regions={self.n_regions} is too many for {X_reg.shape[0]} regressor rows of "
+                f"{structure.n_features + 1} parameters each: at most {max(X_reg.shape[0] // (structure.n_features + 2), 1)}"
+            )
         n_regions = self.n_regions
         if segmenter.uses_n_regions:
             if not isinstance(n_regions, (int, np.integer)) or isinstance(n_regions, bool) or n_regions < 1:
@@ -226,7 +241,7 @@ class PWARX(BaseEstimator):
         self.n_features_in_ = n_inputs
         self.output_range_ = (float(yy.min()), float(yy.max()))
         self.input_ranges_ = np.column_stack([u.min(axis=0), u.max(axis=0)])
-        self.segmentation_info_ = {"method": str(self.segmentation), **seg.info}
+        self.segmentation_info_ = {"method": segmenter.name, **seg.info}
         if sparse_columns is not None:
             self.segmentation_info_["partition_columns"] = [structure.feature_names[c] for c in sparse_columns]
         if self.polish:
@@ -424,10 +439,15 @@ class PWARX(BaseEstimator):
         The first ``max_lag`` outputs are the initial conditions, taken from ``initial_output`` or
         from the measured ``y``. Numba-compiled: about 10^7 samples per second.
         """
-        init = initial_output if initial_output is not None else y
-        u, yy = self._check_inputs(X, init, need_y=self.structure_.max_lag > 0 and init is None)
         m = self.structure_.max_lag
-        y0 = np.zeros(m) if yy is None else yy
+        if initial_output is not None:
+            u, _ = self._check_inputs(X, None, need_y=False)
+            y0 = np.asarray(initial_output, dtype=float).ravel()
+            if not np.all(np.isfinite(y0)):
+                raise DataError("initial_output has a non-finite value")
+        else:
+            u, yy = self._check_inputs(X, y, need_y=m > 0)
+            y0 = np.zeros(m) if yy is None else yy
         if y0.shape[0] < m and u.shape[0] > m:
             raise DataError(f"need {m} initial outputs, got {y0.shape[0]}")
         center, half = self.divergence_band()
@@ -437,11 +457,9 @@ class PWARX(BaseEstimator):
         """Free-run fit % (NRMSE) after the initial conditions; ``nan`` (with a warning) if diverged."""
         u, yy = self._check_inputs(X, y)
         sim = self.simulate(u, yy)
-        m = self.structure_.max_lag
         if sim.diverged:
             warnings.warn(sim.reason, FreeRunDivergedWarning, stacklevel=2)
-            return float("nan")
-        return fit_percent(yy[m:], sim.output[m:])
+        return sim.score(yy)
 
     # ------------------------------------------------------------------ analysis
     def state_space(self) -> list:
@@ -463,7 +481,7 @@ class PWARX(BaseEstimator):
         return {
             "na": st.na, "nb": list(st.nb), "nk": list(st.nk), "constant": st.constant,
             "inputs": list(st.input_names), "output": st.output_name,
-            "segmentation": self.segmentation_info_.get("auto", {}).get("segmentation", self.segmentation),
+            "segmentation": self.segmentation_info_.get("method", str(self.segmentation)),
             "n_regions": int(self.n_regions_), "regions": regions,
             **({"partition_columns": self.segmentation_info_["partition_columns"]}
                if "partition_columns" in self.segmentation_info_ else {}),
@@ -501,5 +519,4 @@ class PWARX(BaseEstimator):
         est.input_ranges_ = (np.asarray(input_ranges, dtype=float) if input_ranges is not None
                              else np.full((structure.n_inputs, 2), np.nan))
         est.segmentation_info_ = dict(segmentation_info or {})
-        est.selection_ = []
         return est

@@ -44,6 +44,17 @@ class SimulationResult:
     diverged_at: int | None = None
     reason: str | None = None
 
+    def score(self, measured) -> float:
+        """Free-run fit % (NRMSE) against the ``measured`` output after the initial conditions;
+        ``nan`` when the run diverged (the one encoding of "diverged" in the package)."""
+        from hwpts.identification.metrics import fit_percent
+
+        y = np.asarray(measured, dtype=float).ravel()
+        if self.diverged:
+            return float("nan")
+        m = self.n_initial
+        return fit_percent(y[m:], self.output[m:])
+
 
 @numba.njit(cache=True, nogil=True)
 def _simulate_kernel(u, y0, n_init, sig, lag, theta, H, g, row_start, center, bound):  # pragma: no cover - compiled

@@ -9,14 +9,15 @@ The registry's keys are the names the CLI accepts (``hwpts identify --segmentati
 - ``clustering``: Ferrari-Trecate et al. (2003) clustering of local parameter vectors;
 - ``alternating``: alternating assignment / least squares with a separability term (k-LinReg, PARC);
 - ``threshold``: thresholds on one regressor column, e.g. ``y(k-1)``, by least squares (SETAR/TARX);
-- ``auto``: method and number of regions chosen by held-out free-run fit.
+
+Choosing the method and the number of regions from the data is model selection, not segmentation:
+:class:`hwpts.identification.PWARXSearch` (``hwpts identify`` without ``--segmentation``).
 """
 
 from __future__ import annotations
 
 from hwpts.errors import ParameterError
 from hwpts.identification.segmentation.alternating import AlternatingSegmenter
-from hwpts.identification.segmentation.auto import AutoSegmenter
 from hwpts.identification.segmentation.average import AverageSegmenter
 from hwpts.identification.segmentation.base import SegmentationResult, Segmenter
 from hwpts.identification.segmentation.clustering import ClusteringSegmenter
@@ -33,7 +34,6 @@ SEGMENTATION_METHODS: dict[str, type[Segmenter]] = {
     "clustering": ClusteringSegmenter,
     "alternating": AlternatingSegmenter,
     "threshold": ThresholdSegmenter,
-    "auto": AutoSegmenter,
 }
 
 __all__ = ["SEGMENTATION_METHODS", "make_segmenter", "Segmenter", "SegmentationResult"]

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from hwpts.errors import ParameterError
 from hwpts.identification.segmentation.base import SegmentationResult, Segmenter, kmeans_labels, standardize
 
 
@@ -83,6 +84,21 @@ def alternate(Phi, ys, Z, labels, s, gamma=1.0, max_iter=50, ridge=1e-8):
 
 SUBSET = 4000  # rows used by the clustering start on large data sets
 ANNEAL_ITER = 15  # alternation steps of each continuation stage (it only has to find the basin)
+AUTO_MIN_RESTARTS = 3
+AUTO_MAX_RESTARTS = 12
+SAME_OBJECTIVE = 1e-6  # relative difference under which two starts reached the same minimum
+
+
+def restarts_needed(objectives, confidence: float = 0.99) -> int:
+    """Starts needed so that the best minimum is found with ``confidence``, from the share of the
+    starts so far that reached it (Lauer 2013's success probability, estimated online)."""
+    obj = np.asarray(objectives, dtype=float)
+    best = obj.min()
+    hits = int(np.sum(obj <= best + SAME_OBJECTIVE * max(abs(best), 1e-300)))
+    p = hits / obj.size
+    if p >= 1.0:
+        return obj.size
+    return int(np.ceil(np.log(1.0 - confidence) / np.log(1.0 - p)))
 
 
 class AlternatingSegmenter(Segmenter):
@@ -90,8 +106,14 @@ class AlternatingSegmenter(Segmenter):
 
     Parameters
     ----------
-    n_restarts : int
-        Number of starts (the first from ``clustering``, then k-means seeds).
+    n_restarts : int or "auto"
+        Number of starts (the first from ``clustering``, then k-means seeds). ``"auto"`` follows
+        Lauer's success-probability argument (Lauer 2013, "Estimating the probability of success of
+        a simple algorithm for switched linear regression"): with ``m`` of ``r`` starts reaching the
+        best objective so far, the chance that one start succeeds is about ``p = m / r``, and
+        ``log(0.01) / log(1 - p)`` starts find the best minimum with 99 % probability; starts run
+        until that many were made (at least 3, at most ``AUTO_MAX_RESTARTS``; fewer on large data,
+        where a single start already sees enough samples to succeed).
     gamma : float
         Weight of the region-separability term (in units of the residual variance).
     max_iter : int
@@ -103,12 +125,12 @@ class AlternatingSegmenter(Segmenter):
 
     name = "alternating"
 
-    def __init__(self, n_restarts: int = 4, gamma: float = 1.0, max_iter: int = 50,
+    def __init__(self, *, n_restarts: int | str = 4, gamma: float = 1.0, max_iter: int = 50,
                  anneal: tuple = ()):
         self.n_restarts = n_restarts
         self.gamma = gamma
         self.max_iter = max_iter
-        self.anneal = tuple(float(a) for a in anneal)
+        self.anneal = anneal
 
     def _restarts(self, X, y, Z, ys, Phi, s, structure, rng):
         """All starts on (X, y); the best (labels, objective, iterations, restart, objectives)."""
@@ -116,12 +138,20 @@ class AlternatingSegmenter(Segmenter):
 
         best = None
         objectives = []
-        for r in range(max(1, self.n_restarts)):
+        auto = isinstance(self.n_restarts, str)
+        if auto and self.n_restarts != "auto":
+            raise ParameterError(f"alternating: n_restarts must be an int >= 1 or 'auto', got {self.n_restarts!r}")
+        budget = AUTO_MAX_RESTARTS if auto else max(1, int(self.n_restarts))
+        if auto and X.shape[0] > 1000:  # large data: one start already sees enough samples
+            budget = max(AUTO_MIN_RESTARTS, int(AUTO_MAX_RESTARTS * 1000 / X.shape[0]))
+        for r in range(budget):
+            if auto and r >= AUTO_MIN_RESTARTS and r >= restarts_needed(objectives):
+                break
             if r == 0:
                 init = ClusteringSegmenter(n_init=3).segment(X, y, s, structure, rng).labels
             else:
                 init = kmeans_labels(np.column_stack([Z, ys]), s, rng, n_init=1)
-            for mult in self.anneal:
+            for mult in tuple(float(a) for a in self.anneal):
                 init, _, _ = alternate(Phi, ys, Z, init, s, self.gamma * mult, ANNEAL_ITER)
             labels, obj, it = alternate(Phi, ys, Z, init, s, self.gamma, self.max_iter)
             objectives.append(obj)

@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from sklearn.base import BaseEstimator
 
 from hwpts.errors import ParameterError
 
@@ -34,8 +35,9 @@ class SegmentationResult:
     info: dict = field(default_factory=dict)
 
 
-class Segmenter:
-    """Base class: ``__init__`` stores keyword parameters only; :meth:`segment` does the work.
+class Segmenter(BaseEstimator):
+    """Base class, a scikit-learn estimator: ``__init__`` stores keyword-only parameters unchanged
+    (so ``sklearn.base.clone`` and ``get_params``/``set_params`` work); :meth:`segment` does the work.
 
     ``segment(X, y, n_regions, structure, rng)`` receives the standard regressors ``X`` (eq. 7),
     targets ``y``, the requested number of regions, the :class:`RegressorStructure` and a numpy
@@ -46,9 +48,6 @@ class Segmenter:
     #: whether the method takes the number of regions from the caller
     uses_n_regions = True
 
-    def get_params(self) -> dict:
-        return {k: v for k, v in vars(self).items() if not k.startswith("_")}
-
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:  # pragma: no cover
         raise NotImplementedError
 
@@ -57,10 +56,6 @@ class Segmenter:
             raise ParameterError(f"n_regions must be an int >= 1, got {n_regions!r}")
         if n_regions > n_rows:
             raise ParameterError(f"n_regions={n_regions} exceeds the {n_rows} training regressors")
-
-    def __repr__(self) -> str:
-        params = ", ".join(f"{k}={v!r}" for k, v in self.get_params().items())
-        return f"{type(self).__name__}({params})"
 
 
 def standardize(X: np.ndarray) -> np.ndarray:

@@ -57,7 +57,7 @@ class ClusteringSegmenter(Segmenter):
 
     name = "clustering"
 
-    def __init__(self, n_neighbors: int | None = None, n_init: int = 10):
+    def __init__(self, *, n_neighbors: int | None = None, n_init: int = 10):
         self.n_neighbors = n_neighbors
         self.n_init = n_init
 

@@ -69,7 +69,7 @@ class HyperplaneSegmenter(Segmenter):
     name = "hyperplane"
     uses_n_regions = False
 
-    def __init__(self, hyperplanes=()):
+    def __init__(self, *, hyperplanes=()):
         self.hyperplanes = hyperplanes
 
     def parsed(self) -> list[Hyperplane]:

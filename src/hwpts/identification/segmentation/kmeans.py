@@ -15,7 +15,7 @@ from hwpts.identification.segmentation.base import SegmentationResult, Segmenter
 class KMeansSegmenter(Segmenter):
     name = "kmeans"
 
-    def __init__(self, include_output: bool = False, n_init: int = 10):
+    def __init__(self, *, include_output: bool = False, n_init: int = 10):
         self.include_output = include_output
         self.n_init = n_init
 

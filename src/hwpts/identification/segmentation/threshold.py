@@ -6,18 +6,21 @@ PWARX model is a *threshold* ARX model (Tong's SETAR/TARX, Tong 1990; Hansen 200
 threshold variable ``x_c`` (a regressor column, default ``y(k-1)``) and ordered thresholds
 ``t_1 < ... < t_{s-1}``, region ``i`` is ``{x : t_{i-1} < x_c <= t_i}`` (a polyhedron, eq. 9).
 
-The thresholds are estimated by conditional least squares: for every candidate split (quantiles of
-``x_c`` on a grid, each region holding at least ``min_share`` of the samples and more rows than
-parameters) the local least squares (eq. 17) are solved and the split with the smallest total
-residual sum of squares wins. Sorting the rows by ``x_c`` and accumulating the normal equations
-makes every split cost one small solve per region, so ``s = 2`` and ``s = 3`` are exhaustive
-searches. The result is deterministic (no random restarts) and the partition is fixed (no boundary
-refinement): few boundary parameters, low variance, which suits free-run simulation.
+The thresholds are estimated by conditional least squares, *exactly*: sorting the rows by ``x_c``
+turns every region into a contiguous block of sorted rows, and accumulating the normal equations
+gives the residual sum of squares of any block from one small solve. The best ``s``-block split
+(each block holding at least ``min_share`` of the rows and more rows than parameters) is then the
+optimal segmentation of a sequence, found by dynamic programming (Bellman 1961; Bai & Perron 1998
+for multiple structural breaks) in ``O(s G^2)`` for ``G`` candidate cuts: every position where
+``x_c`` changes on small data (so the split is the global least-squares optimum), ``n_grid``
+quantiles on large data. With ``column=None`` every regressor column is tried and the one with the
+smallest residual sum of squares wins. The result is deterministic (no random restarts) and the
+partition is fixed (no boundary refinement): few boundary parameters, low variance, which suits
+free-run simulation; on one-dimensional switching (a static map, or a system switching on one
+signal) it is the least-squares estimate of the switching points, which no clustering method is.
 """
 
 from __future__ import annotations
-
-import itertools
 
 import numpy as np
 
@@ -57,77 +60,120 @@ def _sse(G, b, yy, ridge):
     return float(yy - b @ theta)
 
 
+EXACT_ROWS = 400  # up to this many rows, every change of the threshold variable is a candidate cut
+
+
+def _block_sse(CG, Cb, Cy, a, b, ridge):
+    """Residual sums of squares of least squares on sorted-row blocks ``[a_j, b_j)`` (vectorised)."""
+    G = CG[b] - CG[a]
+    r = Cb[b] - Cb[a]
+    yy = Cy[b] - Cy[a]
+    p = G.shape[-1]
+    G = G + ridge * np.eye(p)
+    try:
+        theta = np.linalg.solve(G, r[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        theta = np.einsum("nij,nj->ni", np.linalg.pinv(G), r)
+    return np.maximum(yy - np.einsum("ni,ni->n", r, theta), 0.0)
+
+
+def optimal_split(x, Phi, y, n_regions, min_rows, n_grid=200):
+    """Exact least-squares split of the rows into ``n_regions`` intervals of ``x`` (module doc).
+
+    Returns ``(sse, thresholds)``; ``sse`` is ``inf`` when no admissible split exists.
+    """
+    n, p = Phi.shape
+    order = np.argsort(x, kind="stable")
+    xs, P, ys = x[order], Phi[order], y[order]
+    CG = np.concatenate([np.zeros((1, p, p)), np.cumsum(P[:, :, None] * P[:, None, :], axis=0)])
+    Cb = np.concatenate([np.zeros((1, p)), np.cumsum(P * ys[:, None], axis=0)])
+    Cy = np.concatenate([[0.0], np.cumsum(ys**2)])
+    ridge = 1e-10 * float(np.trace(CG[-1])) / p
+    changes = np.flatnonzero(xs[1:] > xs[:-1]) + 1  # a cut at k splits rows [0, k) | [k, n)
+    changes = changes[(changes >= min_rows) & (changes <= n - min_rows)]
+    if n > EXACT_ROWS and changes.size > n_grid:
+        pick = np.unique(np.searchsorted(changes, np.quantile(changes, np.linspace(0, 1, n_grid))))
+        changes = changes[np.clip(pick, 0, changes.size - 1)]
+        changes = np.unique(changes)
+    if n_regions == 1:
+        return float(_block_sse(CG, Cb, Cy, np.array([0]), np.array([n]), ridge)[0]), []
+    nodes = np.concatenate([[0], changes, [n]])  # block boundaries
+    m = nodes.size
+    ia, ib = np.triu_indices(m, k=1)
+    ok = (nodes[ib] - nodes[ia]) >= min_rows
+    cost = np.full((m, m), np.inf)
+    cost[ia[ok], ib[ok]] = _block_sse(CG, Cb, Cy, nodes[ia[ok]], nodes[ib[ok]], ridge)
+    # D[j] = best cost of covering rows [0, nodes[j]) with the blocks so far
+    D = cost[0].copy()
+    back = []
+    for _ in range(n_regions - 1):
+        total = D[:, None] + cost  # last block from node i to node j
+        arg = np.argmin(total, axis=0)
+        D = total[arg, np.arange(m)]
+        back.append(arg)
+    if not np.isfinite(D[-1]):
+        return np.inf, None
+    cuts = []
+    j = m - 1
+    for arg in reversed(back):
+        j = int(arg[j])
+        cuts.append(int(nodes[j]))
+    cuts = cuts[::-1]
+    return float(D[-1]), [0.5 * (xs[k - 1] + xs[k]) for k in cuts]
+
+
 class ThresholdSegmenter(Segmenter):
-    """Thresholds on one regressor column chosen by least squares (module doc).
+    """Thresholds on one regressor column chosen by exact least squares (module doc).
 
     Parameters
     ----------
-    column : str
-        Threshold variable: a regressor name (``"y(k-1)"``, ``"u1(k-2)"``) or an input/output name.
+    column : str or None
+        Threshold variable: a regressor name (``"y(k-1)"``, ``"u1(k-2)"``) or an input/output name;
+        ``None`` tries every regressor column and keeps the best.
     n_grid : int
-        Candidate thresholds: this many quantiles of the column (between ``min_share`` and
-        ``1 - min_share``).
+        Candidate cuts on large data (more than 400 rows): this many quantiles of the column.
     min_share : float
-        Smallest share of the training rows in each region.
+        Smallest share of the training rows in each region (and always more rows than parameters).
     """
 
     name = "threshold"
     uses_n_regions = True
 
-    def __init__(self, column: str = "y(k-1)", n_grid: int = 60, min_share: float = 0.05):
+    def __init__(self, *, column: str | None = "y(k-1)", n_grid: int = 200, min_share: float = 0.03):
         self.column = column
         self.n_grid = n_grid
         self.min_share = min_share
 
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
         self._check_regions(n_regions, X.shape[0])
-        if n_regions > 3:
-            raise ParameterError(f"threshold segmentation searches 1 to 3 regions exhaustively, got {n_regions}")
         if not 0 < self.min_share < 1 / max(n_regions, 2) or int(self.n_grid) < 2:
             raise ParameterError(f"threshold: min_share must be in (0, 1/n_regions) and n_grid >= 2; "
                                  f"got {self.min_share}, {self.n_grid}")
-        c = structure.column_index(self.column)
         n, nf = X.shape
-        x = X[:, c]
-        if n_regions == 1:
+        if self.column is None:
+            columns = [c for c in range(nf) if np.ptp(X[:, c]) > 0]
+        else:
+            columns = [structure.column_index(self.column)]
+        if n_regions == 1 or not columns:
+            name = self.column if self.column is not None else None
             return SegmentationResult(np.zeros(n, dtype=np.int64), 1, RegionPartition.single(nf),
-                                      refine=False, info={"column": self.column, "thresholds": []})
-        order = np.argsort(x, kind="stable")
-        xs = x[order]
-        Phi = structure.extend(X)[order]
-        ys = y[order]
+                                      refine=False, info={"column": name, "thresholds": []})
+        Phi = structure.extend(X)
         p = Phi.shape[1]
-        # cumulative normal equations over the sorted rows: block [a, b) = C[b] - C[a]
-        CG = np.concatenate([np.zeros((1, p, p)), np.cumsum(Phi[:, :, None] * Phi[:, None, :], axis=0)])
-        Cb = np.concatenate([np.zeros((1, p)), np.cumsum(Phi * ys[:, None], axis=0)])
-        Cy = np.concatenate([[0.0], np.cumsum(ys**2)])
-        ridge = 1e-10 * float(np.trace(CG[-1])) / p
         min_rows = max(int(np.ceil(self.min_share * n)), p + 1)
-        qs = np.linspace(self.min_share, 1 - self.min_share, int(self.n_grid))
-        # candidate cut positions: split between sorted rows k-1 and k, only where x changes
-        cuts = sorted({int(np.searchsorted(xs, v, side="right")) for v in np.quantile(xs, qs)})
-        cuts = [k for k in cuts if min_rows <= k <= n - min_rows and xs[k - 1] < xs[k]]
-        if not cuts:
-            raise IdentificationError(f"threshold: column {self.column!r} has too few distinct values to split")
-
-        def block(a, b):
-            return _sse(CG[b] - CG[a], Cb[b] - Cb[a], Cy[b] - Cy[a], ridge)
-
-        best, best_cuts = np.inf, None
-        for combo in itertools.combinations(cuts, n_regions - 1):
-            bounds = (0, *combo, n)
-            if any(bounds[i + 1] - bounds[i] < min_rows for i in range(n_regions)):
-                continue
-            total = sum(block(bounds[i], bounds[i + 1]) for i in range(n_regions))
-            if total < best:
-                best, best_cuts = total, combo
-        if best_cuts is None:
+        best = (np.inf, None, None)
+        for c in columns:
+            sse, thresholds = optimal_split(X[:, c], Phi, y, n_regions, min_rows, int(self.n_grid))
+            if sse < best[0]:
+                best = (sse, c, thresholds)
+        sse, c, thresholds = best
+        if c is None:
             raise IdentificationError(
-                f"threshold: no split of {n} rows into {n_regions} regions of >= {min_rows} rows each"
+                f"threshold: no split of {n} rows into {n_regions} regions of >= {min_rows} rows each "
+                f"on {'any column' if self.column is None else repr(self.column)}"
             )
-        thresholds = [0.5 * (xs[k - 1] + xs[k]) for k in best_cuts]
         partition = threshold_partition(c, thresholds, nf)
         labels = partition.predict(X)
         return SegmentationResult(labels, n_regions, partition, refine=False,
-                                  info={"column": self.column, "thresholds": [float(t) for t in thresholds],
-                                        "sse": float(best)})
+                                  info={"column": structure.feature_names[c],
+                                        "thresholds": [float(t) for t in thresholds], "sse": float(sse)})

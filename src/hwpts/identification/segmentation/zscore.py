@@ -19,7 +19,7 @@ class ZScoreSegmenter(Segmenter):
     name = "zscore"
     uses_n_regions = False
 
-    def __init__(self, threshold: float = 0.0):
+    def __init__(self, *, threshold: float = 0.0):
         self.threshold = threshold
 
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:

@@ -1,0 +1,451 @@
+"""The one model search: :class:`PWARXSearch` wraps a :class:`~hwpts.identification.PWARX`
+(scikit-learn's shape: ``GridSearchCV`` wraps an estimator).
+
+Every candidate (a set of the estimator's parameters) is fitted on the training part of each
+cross-validation split and simulated in *free run* over the held-out block, from the block's first
+measured outputs (initial conditions). Its score is the mean free-run fit % over the blocks; a
+candidate whose free run diverges on any block, or whose fit fails, scores ``nan`` and ranks last.
+The best candidate is refitted on all the data (``best_estimator_``); a refit whose own free run
+diverges on a block, or scores (in sample) more than ``refit_margin`` points below its
+cross-validated mean on the same blocks (a learned partition can land differently on all the data),
+is passed over for the next candidate.
+
+Two ways to say what to try:
+
+- ``param_grid`` (a dict of lists, or a list of such dicts / of plain dicts): every combination,
+  as ``GridSearchCV`` (the paper pipeline's ``best`` uses this with a held-out tail);
+- ``param_grid=None`` (the default, what ``hwpts identify`` runs): an adaptive search that a user
+  would otherwise do by hand:
+
+  1. **orders** (only those left as ``"auto"``: ``PWARXSearch(..., orders="auto")`` or a dict of
+     candidate lists): each (na, nb, nk) is scored as a single ARX model; the ``n_orders`` best go on;
+  2. **regions**: for each kept order, one region (ARX), then 2, 3, ... regions with every method
+     of ``methods``; the count grows until ``patience`` successive counts fail to improve the best
+     score, or until every region would hold fewer than ``3 (p + 1)`` rows;
+     A candidate whose running mean over the blocks falls 10 points below the best so far is
+     not scored on its remaining blocks (racing, Maron & Moore 1994): it could not win;
+  3. **choice**: the best score wins, but a candidate within ``tolerance`` points with fewer
+     regions (then fewer parameters) is preferred: the simplest model the data support;
+  4. **polish** (``try_polish``): the winner is also scored with the simulation-error polish and
+     polished if that gains more than ``tolerance``.
+
+Candidates of one stage are independent: a map over (parameters, split) pairs, run in processes
+with ``n_jobs`` (joblib, which also runs them on a Dask cluster inside
+``joblib.parallel_backend("dask")``). Same ``random_state`` -> same choice.
+"""
+
+from __future__ import annotations
+
+import itertools
+import time
+import warnings
+
+import numpy as np
+from sklearn.base import BaseEstimator, clone
+
+from hwpts.errors import HwptsError, IdentificationError, ParameterError
+from hwpts.identification.selection.splitters import BlockedSplit, breaks_of
+
+__all__ = ["PWARXSearch", "expand_grid", "DEFAULT_METHODS", "ORDER_GRID"]
+
+DEFAULT_METHODS = ("threshold", "alternating")
+ORDER_GRID = {"output_order": (0, 1, 2, 3, 4), "input_order": (1, 2, 3, 4), "input_delay": (1, 0)}
+ORDER_KEYS = ("output_order", "input_order", "input_delay")
+MIN_BLOCK = 10  # samples of a held-out block, beyond the initial conditions
+REGION_CAP = 10  # most regions the adaptive search tries (max_regions="auto")
+PRUNE_MARGIN = 10.0  # points below the best so far at which a candidate's remaining blocks are skipped
+# methods' settings in the adaptive search: thresholds on any column, restarts as the data need
+METHOD_PARAMS = {"threshold": {"column": None}, "alternating": {"n_restarts": "auto"}}
+
+
+def expand_grid(grid) -> list[dict]:
+    """All combinations of a dict of lists (scikit-learn's ``ParameterGrid``); a list of dicts of
+    lists gives the union; a list of plain dicts is returned as it is."""
+    if isinstance(grid, dict):
+        keys = list(grid)
+        return [dict(zip(keys, values)) for values in itertools.product(*(grid[k] for k in keys))]
+    out = []
+    for item in grid:
+        if isinstance(item, dict) and item and all(isinstance(v, (list, tuple)) for v in item.values()):
+            out.extend(expand_grid(item))
+        else:
+            out.append(dict(item))
+    return out
+
+
+def _score_split(estimator, params, u, y, train, test, names=None, output_name=None):
+    """Free-run fit % of ``params`` fitted on ``train``, simulated over ``test`` (nan if diverged)."""
+    model = clone(estimator).set_params(**params)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model.fit(u[train], y[train], names, output_name, breaks=breaks_of(train) or None)
+        start, stop = int(test[0]), int(test[-1]) + 1
+        sim = model.simulate(u[start:stop], y[start:stop])
+    return sim.score(y[start:stop]), int(model.n_regions_)
+
+
+def _evaluate(estimator, params, u, y, splits, prune_below=-np.inf, names=None, output_name=None):
+    """One table row: the candidate's block fits, mean, or why it failed. A candidate whose running
+    mean falls ``PRUNE_MARGIN`` points below ``prune_below`` (the best complete mean so far) is not
+    scored on its remaining blocks (``pruned``; ranked after the complete ones)."""
+    row = {"params": params, "split_fits_percent": None, "mean_fit_percent": None, "diverged": False,
+           "pruned": False, "error": None, "n_regions_fitted": None, "fit_time_s": None}
+    t0 = time.perf_counter()
+    fits, regions = [], []
+    try:
+        for train, test in splits:
+            fit, s = _score_split(estimator, params, u, y, train, test, names, output_name)
+            fits.append(fit)
+            regions.append(s)
+            if not np.isfinite(fit):
+                row["diverged"] = True
+                break
+            if len(fits) < len(splits) and np.mean(fits) < prune_below - PRUNE_MARGIN:
+                row["pruned"] = True
+                break
+    except HwptsError as error:
+        row["error"] = str(error)
+    except np.linalg.LinAlgError as error:
+        row["error"] = f"singular least squares ({error})"
+    row["fit_time_s"] = round(time.perf_counter() - t0, 4)
+    if row["error"] is None:
+        row["split_fits_percent"] = [round(float(f), 3) for f in fits]
+        row["n_regions_fitted"] = int(max(regions)) if regions else None
+        if not row["diverged"] and not row["pruned"]:
+            row["mean_fit_percent"] = float(np.mean(fits))
+    return row
+
+
+class PWARXSearch(BaseEstimator):
+    """Choose a PWARX's settings by cross-validated free-run fit on the training data only.
+
+    Parameters
+    ----------
+    estimator : PWARX, optional
+        The model whose parameters are searched (default ``PWARX()``); its other parameters
+        (ridge, partition columns, random_state...) are kept.
+    param_grid : dict, list, or None
+        Explicit candidates (see :func:`expand_grid`); ``None`` runs the adaptive search (module doc).
+    cv : int, splitter or None
+        Number of blocks of :class:`BlockedSplit`, or any splitter yielding ``(train, test)`` index
+        arrays with a contiguous ``test`` (``sklearn.model_selection.TimeSeriesSplit``,
+        :class:`HoldoutSplit`). Default: 5 blocks (3 beyond 5,000 samples, where each block is
+        long enough to visit every regime), fewer (down to 2) when the record is short.
+    methods : sequence of str
+        Segmentation methods of the adaptive search.
+    orders : None, "auto" or dict
+        ``None``: the estimator's orders; ``"auto"``: searched over :data:`ORDER_GRID`; a dict
+        ``{"output_order": [...], "input_order": [...], "input_delay": [...]}`` (missing keys keep
+        the estimator's value).
+    n_orders : int
+        Orders carried from the ARX stage to the region stage.
+    max_regions : int or "auto"
+        Largest number of regions tried ("auto": at most 10, and while the training rows hold
+        ``3 p`` rows a region for ``p`` parameters a mode).
+    patience : int
+        Region counts in a row without a better score before the growth stops.
+    tolerance : float
+        Points of fit within which the simpler candidate is preferred (and the polish must gain).
+    refit_margin : float
+        The refit on all data must score on the blocks at least its cross-validated mean minus this.
+    try_polish : bool or "auto"
+        Score the winner with the simulation-error polish too; "auto": only on records of at most
+        5,000 samples with an autoregressive part (the polish costs a dense Jacobian).
+    n_jobs : int or None
+        Processes for the candidates (joblib); ``None`` runs them in this process.
+    progress : bool
+        A progress bar on a terminal.
+
+    Attributes
+    ----------
+    best_estimator_ : PWARX
+        The winner refitted on all the data.
+    best_params_ : dict
+    best_score_ : float
+        Its mean held-out free-run fit %.
+    cv_results_ : list of dict
+        One row per candidate, in the order tried: ``params``, ``split_fits_percent``,
+        ``mean_fit_percent`` (``None`` when diverged or failed), ``diverged``, ``error``,
+        ``n_regions_fitted``, ``fit_time_s``, ``stage``, ``rank`` (1 = best; diverged/failed last),
+        ``chosen``.
+    n_splits_ : int
+    """
+
+    def __init__(self, estimator=None, param_grid=None, *, cv=None, methods=DEFAULT_METHODS, orders=None,
+                 n_orders: int = 3, max_regions="auto", patience: int = 2, tolerance: float = 0.5,
+                 try_polish="auto", refit_margin: float = 5.0, n_jobs=None, progress: bool = False):
+        self.estimator = estimator
+        self.param_grid = param_grid
+        self.cv = cv
+        self.methods = methods
+        self.orders = orders
+        self.n_orders = n_orders
+        self.max_regions = max_regions
+        self.patience = patience
+        self.tolerance = tolerance
+        self.try_polish = try_polish
+        self.refit_margin = refit_margin
+        self.n_jobs = n_jobs
+        self.progress = progress
+
+    # ------------------------------------------------------------------ helpers
+    def _base(self):
+        from hwpts.identification.pwarx import PWARX
+
+        return clone(self.estimator) if self.estimator is not None else PWARX()
+
+    def _order_grid(self, base) -> list[dict]:
+        if self.orders is None:
+            return [{}]
+        if self.orders == "auto":
+            grid = dict(ORDER_GRID)
+        elif isinstance(self.orders, dict):
+            unknown = set(self.orders) - set(ORDER_KEYS)
+            if unknown:
+                raise ParameterError(f"PWARXSearch: orders has unknown keys {sorted(unknown)}; valid are {list(ORDER_KEYS)}")
+            grid = {k: tuple(v) for k, v in self.orders.items()}
+        else:
+            raise ParameterError(f"PWARXSearch: orders must be None, 'auto' or a dict of lists, got {self.orders!r}")
+        for key, values in grid.items():
+            if not values or any(isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 0 for v in values):
+                raise ParameterError(f"PWARXSearch: orders[{key!r}] must be non-empty ints >= 0, got {values!r}")
+        return expand_grid(grid)
+
+    def _splits(self, n: int, max_lag: int):
+        min_block = MIN_BLOCK + max_lag
+        cv = self.cv
+        if cv is None:
+            k = min(5 if n <= 5000 else 3, n // min_block)
+            if k < 2:
+                raise ParameterError(
+                    f"{n} samples are too few to choose a model: cross-validation needs at least 2 blocks of "
+                    f"{min_block} samples ({max_lag} initial conditions + {MIN_BLOCK}); give the model settings "
+                    f"(orders, segmentation, regions) instead"
+                )
+            cv = BlockedSplit(k, min_block=min_block)
+        elif isinstance(cv, (int, np.integer)) and not isinstance(cv, bool):
+            cv = BlockedSplit(int(cv), min_block=min_block)
+        splits = [(np.asarray(tr), np.asarray(te)) for tr, te in cv.split(np.zeros((n, 1)))]
+        for train, test in splits:
+            if test.size <= max_lag + 1 or np.any(np.diff(test) != 1):
+                raise ParameterError(f"PWARXSearch: every test block must be contiguous and longer than "
+                                     f"{max_lag + 1} samples (the initial conditions)")
+        return splits
+
+    def _run(self, base, candidates, u, y, splits, stage, bar, best=-np.inf):
+        from joblib import Parallel, delayed
+
+        names, oname = self._names
+        if self.n_jobs in (None, 1):
+            rows = []
+            for params in candidates:
+                rows.append(_evaluate(base, params, u, y, splits, best, names, oname))
+                best = max(best, self._score(rows[-1]))
+                if bar is not None:
+                    bar.update(1)
+        else:
+            rows = Parallel(n_jobs=self.n_jobs)(delayed(_evaluate)(base, p, u, y, splits, -np.inf, names, oname)
+                                                for p in candidates)
+            if bar is not None:
+                bar.update(len(candidates))
+        for row in rows:
+            row["stage"] = stage
+        return rows
+
+    @staticmethod
+    def _score(row) -> float:
+        v = row["mean_fit_percent"]
+        return -np.inf if v is None else v
+
+    # ------------------------------------------------------------------ fit
+    def fit(self, X, y=None, input_names=None, output_name=None):
+        """Search, then refit the winner on all of ``(X, y)`` (or an IODataset). Returns ``self``."""
+        base = self._base()
+        u, yy, names, oname = base._signals(X, y, input_names, output_name)
+        self._names = (names, oname)
+        n = yy.shape[0]
+        if isinstance(self.tolerance, bool) or not isinstance(self.tolerance, (int, float)) or not self.tolerance >= 0:
+            raise ParameterError(f"PWARXSearch: tolerance must be a number >= 0, got {self.tolerance!r}")
+        order_grid = self._order_grid(base)
+        max_lag = max(self._max_lag(base, o) for o in order_grid)
+        splits = self._splits(n, max_lag)
+        self.n_splits_ = len(splits)
+        bar = None
+        if self.progress:
+            from tqdm import tqdm
+
+            bar = tqdm(desc="model search", unit="candidate", disable=None)
+        try:
+            if self.param_grid is not None:
+                candidates = expand_grid(self.param_grid)
+                if not candidates:
+                    raise ParameterError("PWARXSearch: param_grid leaves nothing to try")
+                table = self._run(base, candidates, u, yy, splits, "grid", bar)
+            else:
+                table = self._adaptive(base, order_grid, u, yy, splits, bar)
+        finally:
+            if bar is not None:
+                bar.close()
+        self.cv_results_ = table
+        self._rank(table)
+        self._choose_and_refit(base, table, u, yy, names, oname, splits)
+        return self
+
+    @staticmethod
+    def _max_lag(base, orders) -> int:
+        na = orders.get("output_order", base.output_order)
+        nb = orders.get("input_order", base.input_order)
+        nk = orders.get("input_delay", base.input_delay)
+        nbs = np.atleast_1d(nb)
+        nks = np.atleast_1d(nk)
+        return int(max([na] + [int(k) + int(b) - 1 for b, k in zip(np.broadcast_to(nbs, max(nbs.size, nks.size)),
+                                                                 np.broadcast_to(nks, max(nbs.size, nks.size)))]))
+
+    def _adaptive(self, base, order_grid, u, y, splits, bar):
+        table = []
+        arx = {"segmentation": "average", "n_regions": 1, "segmentation_params": None}
+        if len(order_grid) > 1:
+            rows = self._run(base, [{**o, **arx} for o in order_grid], u, y, splits, "orders", bar)
+            table.extend(rows)
+            ranked = sorted(rows, key=lambda r: -self._score(r))
+            keep = [{k: r["params"][k] for k in ORDER_KEYS if k in r["params"]} for r in ranked
+                    if r["mean_fit_percent"] is not None][: max(1, int(self.n_orders))]
+            if not keep:
+                raise IdentificationError("every order tried failed or diverged as an ARX model; "
+                                          "check the data or give the orders")
+        else:
+            keep = order_grid
+            table.extend(self._run(base, [{**order_grid[0], **arx}], u, y, splits, "regions", bar))
+        methods = tuple(self.methods)
+        if not methods:
+            raise ParameterError("PWARXSearch: methods leaves nothing to try")
+        n_train = min(len(tr) for tr, _ in splits)
+        for orders in keep:
+            best = max([self._score(r) for r in table if self._same_orders(r, orders)], default=-np.inf)
+            p = self._n_params(base, orders, u.shape[1])
+            top = min(n_train // (3 * p), REGION_CAP)
+            if self.max_regions != "auto":
+                top = min(n_train // (3 * p), int(self.max_regions))
+            misses = 0
+            for s in range(2, max(top, 1) + 1):
+                cands = [{**orders, "segmentation": m, "n_regions": s,
+                          "segmentation_params": METHOD_PARAMS.get(m)} for m in methods]
+                overall = max((self._score(r) for r in table), default=-np.inf)
+                rows = self._run(base, cands, u, y, splits, "regions", bar, overall)
+                table.extend(rows)
+                stage_best = max((self._score(r) for r in rows), default=-np.inf)
+                if stage_best > best:
+                    best, misses = stage_best, 0
+                else:
+                    misses += 1
+                    if misses >= self.patience:
+                        break
+        return table
+
+    @staticmethod
+    def _same_orders(row, orders) -> bool:
+        return all(row["params"].get(k) == v for k, v in orders.items())
+
+    @staticmethod
+    def _n_params(base, orders, n_inputs) -> int:
+        na = orders.get("output_order", base.output_order)
+        nb = np.broadcast_to(np.atleast_1d(orders.get("input_order", base.input_order)), (n_inputs,))
+        return int(na + int(np.sum(nb)) + 1)
+
+    def _rank(self, table):
+        order = sorted(range(len(table)), key=lambda i: -self._score(table[i]))
+        for rank, i in enumerate(order, start=1):
+            table[i]["rank"] = rank
+
+    def _preference(self, base, table, u):
+        """Candidates in the order they are tried for the refit: within ``tolerance`` of the best,
+        fewer regions then fewer parameters first; then the rest by score."""
+        ok = [r for r in table if r["mean_fit_percent"] is not None]
+        if not ok:
+            reasons = sorted({r["error"] or "free run diverged" for r in table})[:3]
+            raise IdentificationError("every candidate model diverged in free run or failed: " + "; ".join(reasons))
+        top = max(r["mean_fit_percent"] for r in ok)
+        near = [r for r in ok if r["mean_fit_percent"] >= top - self.tolerance]
+        near.sort(key=lambda r: (r["n_regions_fitted"] or 1,
+                                 self._n_params(base, r["params"], u.shape[1]), -r["mean_fit_percent"]))
+        rest = sorted((r for r in ok if r not in near), key=lambda r: -r["mean_fit_percent"])
+        return near + rest
+
+    def _refit(self, base, params, u, y, names, oname, splits, cv_mean):
+        model = clone(base).set_params(**params)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            model.fit(u, y, names, oname)
+            fits = []
+            for _, test in splits:
+                start, stop = int(test[0]), int(test[-1]) + 1
+                sim = model.simulate(u[start:stop], y[start:stop])
+                if sim.diverged:
+                    return None, "the refit on all data diverges in free run on a block"
+                fits.append(sim.score(y[start:stop]))
+        if np.mean(fits) < cv_mean - self.refit_margin:
+            return None, (f"refit on all data: block fit {np.mean(fits):.1f} % is more than {self.refit_margin} "
+                          f"points below the cross-validated {cv_mean:.1f} %")
+        return model, None
+
+    def _choose_and_refit(self, base, table, u, y, names, oname, splits):
+        for row in self._preference(base, table, u):
+            params = dict(row["params"])
+            polish = self.try_polish
+            if polish == "auto":
+                polish = y.shape[0] <= 5000 and params.get("output_order", base.output_order) > 0
+            if polish and not clone(base).set_params(**params).polish:
+                trial = _evaluate(base, {**params, "polish": True}, u, y, splits, -np.inf, *self._names)
+                trial["stage"] = "polish"
+                table.append(trial)
+                if trial["mean_fit_percent"] is not None and \
+                        trial["mean_fit_percent"] > row["mean_fit_percent"] + self.tolerance:
+                    params, row = trial["params"], trial
+            try:
+                model, why = self._refit(base, params, u, y, names, oname, splits, row["mean_fit_percent"])
+            except HwptsError as error:
+                model, why = None, f"refit on all data failed: {error}"
+            if model is None:
+                row["error"] = why
+                continue
+            row["chosen"] = True
+            self._rank(table)
+            self.best_params_ = params
+            self.best_score_ = float(row["mean_fit_percent"])
+            self.best_estimator_ = model
+            return
+        raise IdentificationError("every candidate's refit on all data diverged or failed")
+
+    # ------------------------------------------------------------------ delegation
+    def _check(self):
+        from sklearn.utils.validation import check_is_fitted
+
+        check_is_fitted(self, "best_estimator_")
+        return self.best_estimator_
+
+    def predict(self, X, y=None):
+        """One-step-ahead prediction of the chosen model."""
+        return self._check().predict(X, y)
+
+    def simulate(self, X, y=None, initial_output=None):
+        """Free run of the chosen model."""
+        return self._check().simulate(X, y, initial_output)
+
+    def score(self, X, y=None) -> float:
+        """Free-run fit % of the chosen model."""
+        return self._check().score(X, y)
+
+    def candidate_table(self) -> list[dict]:
+        """``cv_results_`` flattened for JSON: parameters inline, floats rounded."""
+        self._check()
+        out = []
+        for row in self.cv_results_:
+            flat = {k: v for k, v in row["params"].items() if k != "segmentation_params"}
+            for key in ("mean_fit_percent", "split_fits_percent", "diverged", "pruned", "error", "n_regions_fitted",
+                        "stage", "rank", "fit_time_s"):
+                value = row.get(key)
+                flat[key] = round(value, 3) if isinstance(value, float) else value
+            if row.get("chosen"):
+                flat["chosen"] = True
+            out.append(flat)
+        return out
