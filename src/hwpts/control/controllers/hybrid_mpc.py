@@ -29,7 +29,7 @@ class HybridMPCController(MPCController):
     name = "hybrid-mpc"
 
     def __init__(self, bank, half_width, inverse=True, sample_time=0.01, horizon: int = 4, moves: int = 2,
-                 move_weight: float = 20.0, time_limit_s: float = 0.04, **kwargs):
+                 move_weight: float = 20.0, time_limit_s: float = 0.5, **kwargs):
         super().__init__(bank, half_width, inverse, sample_time, horizon=horizon, moves=moves, **kwargs)
         self.move_weight_l1 = float(move_weight)
         self.time_limit = float(time_limit_s)
