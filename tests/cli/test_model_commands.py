@@ -223,3 +223,11 @@ def test_search_bad_inputs_give_one_line(tmp_path, data_csv, capsys):
     write_csv(short, {"u1": d.inputs[:, 0], "u2": d.inputs[:, 1], "y": d.output})
     _expect_error(capsys, ["identify", str(short), *IDENTIFY, "--segmentation", "alternating", "--regions", "50",
                            "--out", str(out)], "n_regions=50 is too many for 298 regressor rows", out)
+
+
+def test_hyperplane_with_a_negative_first_coefficient(tmp_path, data_csv, capsys):
+    """The documented form for a negative first coefficient: --hyperplane=-1,0,0.2."""
+    out = tmp_path / "m.json"
+    assert main(["identify", str(data_csv), *IDENTIFY, "--hyperplane=-1,0,0.2", "--out", str(out)]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["segmentation"] == "hyperplane" and summary["n_regions"] == 2

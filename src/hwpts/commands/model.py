@@ -298,7 +298,8 @@ def register(subparsers):
                    help="number of regions (default auto: grown while the held-out fit improves)")
     p.add_argument("--hyperplane", action="append", default=[], metavar='"a,b,c"',
                    help="a*x1 + b*x2 + c >= 0 on the first two inputs, or 'a,b,c@col1,col2' on named "
-                        "regressor columns; repeat for a decision list (m hyperplanes, m+1 regions)")
+                        "regressor columns; repeat for a decision list (m hyperplanes, m+1 regions); write "
+                        "--hyperplane=-1,0,2.8 when the first coefficient is negative")
     p.add_argument("--zero-region", type=int, action="append", default=[], metavar="I",
                    help="region I (1-based) is the zero mode y = 0 (paper eq. 18)")
     p.add_argument("--partition-column", action="append", default=[], metavar="COL",

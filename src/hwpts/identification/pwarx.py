@@ -26,7 +26,13 @@ from sklearn.utils.validation import check_is_fitted
 from hwpts.dataset import IODataset
 from hwpts.errors import DataError, IdentificationError, ParameterError
 from hwpts.identification.local_models import MODEL_KINDS, RegionWarning, fit_local_models
-from hwpts.identification.partition import RegionPartition, fit_linear_partition
+from hwpts.identification.partition import (
+    TRIM,
+    PartitionLearner,
+    RegionPartition,
+    drop_empty_regions,
+    fit_linear_partition,
+)
 from hwpts.identification.regressors import RegressorStructure, validate_signals
 from hwpts.identification.segmentation import make_segmenter
 from hwpts.identification.simulation import SimulationResult, one_step_pwarx, simulate_pwarx
@@ -35,10 +41,6 @@ from hwpts.identification.statespace import mode_state_space
 __all__ = ["PWARX", "FreeRunDivergedWarning"]
 
 DIVERGENCE_FACTOR = 50.0
-TRIM = 3.0  # outlier threshold (robust std) of the local least squares of learned partitions
-CONFIDENCE_MARGIN = 4.0  # cost margin for a sample to train the region classifier
-CLASSIFIER_ROWS = 6000  # most rows used to refit the region classifier in a refinement round
-SPARSE_TOL = 0.05  # a column whose boundary weight is below this share of the largest is dropped
 
 
 class FreeRunDivergedWarning(UserWarning):
@@ -89,6 +91,12 @@ class PWARX(BaseEstimator):
         that depend on a few signals (the paper's fracture line: valve voltage and pump speed) are
         then estimated in that subspace, where the data are dense, instead of carrying noise in
         every other direction.
+    max_rows : int or None
+        Learned segmentations (clustering, alternating, k-means) label at most this many regressor
+        rows drawn at random (seeded); a linear classifier extends their labels to every row, and
+        the boundary refinement and the local least squares use every row. The segmentation's cost
+        grows with the rows, its labels' quality hardly beyond a few thousand (default 5,000;
+        ``None``: all rows).
     polish : bool
         Refine the local parameters by minimising the free-run simulation error on the training
         data (partition fixed; see :mod:`hwpts.identification.polish`), kept only if better.
@@ -115,7 +123,8 @@ class PWARX(BaseEstimator):
     def __init__(self, output_order=1, input_order=1, input_delay=1, n_regions=2,
                  segmentation="clustering", hyperplanes=None, region_models=None, constant=True,
                  ridge=0.0, refinement_rounds=3, classifier_C=1e4, segmentation_params=None,
-                 polish=False, partition_columns=None, sparse_partition=True, random_state=None):
+                 polish=False, partition_columns=None, sparse_partition=True, max_rows=5000,
+                 random_state=None):
         self.output_order = output_order
         self.input_order = input_order
         self.input_delay = input_delay
@@ -131,6 +140,7 @@ class PWARX(BaseEstimator):
         self.polish = polish
         self.partition_columns = partition_columns
         self.sparse_partition = sparse_partition
+        self.max_rows = max_rows
         self.random_state = random_state
 
     # ------------------------------------------------------------------ fitting
@@ -200,9 +210,9 @@ class PWARX(BaseEstimator):
             if target.shape[0] <= structure.n_features + 1:
                 raise DataError(f"{target.shape[0]} regressor rows are left after the breaks {list(breaks)}: "
                                 f"too few to fit")
-        self._pcols = None
+        pcols = None
         if self.partition_columns is not None:
-            self._pcols = sorted({structure.column_index(c) for c in self.partition_columns})
+            pcols = sorted({structure.column_index(c) for c in self.partition_columns})
         if segmenter.uses_n_regions and isinstance(self.n_regions, (int, np.integer)) \
                 and not isinstance(self.n_regions, bool) and self.n_regions > X_reg.shape[0] // (structure.n_features + 2):
             raise ParameterError(
@@ -213,7 +223,14 @@ class PWARX(BaseEstimator):
         if segmenter.uses_n_regions:
             if not isinstance(n_regions, (int, np.integer)) or isinstance(n_regions, bool) or n_regions < 1:
                 raise ParameterError(f"n_regions must be an int >= 1 for {self.segmentation!r}, got {n_regions!r}")
-        seg = segmenter.segment(X_reg, target, n_regions, structure, rng)
+        X_seg, y_seg = X_reg, target
+        limit = self.max_rows
+        if limit is not None and (isinstance(limit, bool) or not isinstance(limit, (int, np.integer)) or limit < 100):
+            raise ParameterError(f"max_rows must be None or an int >= 100, got {limit!r}")
+        if segmenter.learns_partition and limit is not None and X_reg.shape[0] > limit:
+            rows = np.sort(rng.choice(X_reg.shape[0], int(limit), replace=False))
+            X_seg, y_seg = X_reg[rows], target[rows]
+        seg = segmenter.segment(X_seg, y_seg, n_regions, structure, rng)
         s = seg.n_regions
         kinds = self._kinds(s)
         sparse_columns = None
@@ -221,9 +238,19 @@ class PWARX(BaseEstimator):
             partition = seg.partition
             labels = partition.predict(X_reg)
         else:
-            labels, partition, sparse_columns = self._learn_partition(X_reg, target, seg.labels, s, kinds,
-                                                                      seg.refine, structure)
-            s = partition.n_regions
+            learner = PartitionLearner(refinement_rounds=self.refinement_rounds if seg.refine else 0,
+                                       C=self.classifier_C, ridge=self.ridge, sparse=self.sparse_partition,
+                                       random_state=self.random_state)
+            seg_labels = seg.labels
+            if X_seg is not X_reg:  # the segmentation saw a subsample: extend its labels to every row
+                seg_labels = fit_linear_partition(X_seg, seg.labels, s, C=self.classifier_C, columns=pcols).predict(X_reg)
+            _, partition, sparse_columns = learner.learn(X_reg, target, seg_labels, s, structure.constant, pcols)
+            labels = partition.predict(X_reg)
+            labels, s = drop_empty_regions(labels, partition.n_regions)
+            if s != partition.n_regions:
+                partition = fit_linear_partition(X_reg, labels, s, C=self.classifier_C,
+                                                 columns=pcols if sparse_columns is None else sparse_columns)
+                labels = partition.predict(X_reg)
             kinds = self._kinds(s)
         learned = seg.partition is None and s > 1
         local = fit_local_models(X_reg, target, labels, s, structure.constant, kinds, self.ridge,
@@ -262,130 +289,6 @@ class PWARX(BaseEstimator):
             if kind not in MODEL_KINDS:
                 raise ParameterError(f"unknown region model {kind!r}; valid are {list(MODEL_KINDS)}")
         return kinds
-
-    def _learn_partition(self, X, y, labels, s, kinds, refine, structure):
-        """Region classifier over regressors (eq. 9) and boundary refinement; drops empty regions.
-
-        Each refinement round fits the local models (eq. 17, trimming outliers), scores every
-        sample against every mode with ``cost_ik = r_ik^2 / sigma^2 - log p_i(x_k)`` (residual plus
-        the classifier's confidence, which separates modes with equal parameters), and refits the
-        classifier on the samples whose best mode wins by a clear margin. Ambiguous samples near a
-        boundary carry no information about where it lies, so they are left to the classifier.
-        """
-        labels = np.asarray(labels, dtype=np.int64)
-        partition = fit_linear_partition(X, labels, s, C=self.classifier_C, columns=self._pcols)
-        train_X, train_labels = X, labels
-        labels = partition.predict(X)
-        rounds = self.refinement_rounds if (refine and s > 1) else 0
-        p = X.shape[1] + 1
-        rng_sub = np.random.default_rng(self.random_state)
-        for _ in range(rounds):
-            labels, s = self._drop_empty(labels, s)
-            if s == 1:
-                break
-            local = fit_local_models(X, y, labels, s, structure.constant, ("affine",) * s, self.ridge,
-                                     warn=False, trim=TRIM)
-            R = local.residuals(X, y) ** 2
-            assigned = R[np.arange(len(y)), labels]
-            sigma2 = float(np.median(assigned)) / 0.4549 + 1e-12 * (np.var(y) + 1e-300)
-            logp = partition.log_proba(X) if partition.n_regions == s else None
-            cost = R / sigma2 - (logp if logp is not None else 0.0)
-            order = np.sort(cost, axis=1)
-            proposal = np.argmin(cost, axis=1)
-            confident = (order[:, 1] - order[:, 0]) > CONFIDENCE_MARGIN
-            if np.bincount(proposal[confident], minlength=s).min() < p:
-                confident[:] = True
-            confident = self._informative(confident, logp, rng_sub)
-            train_X, train_labels = X[confident], proposal[confident]
-            partition = fit_linear_partition(train_X, train_labels, s, C=self.classifier_C, columns=self._pcols)
-            new_labels = partition.predict(X)
-            if np.array_equal(new_labels, labels):
-                break
-            labels = new_labels
-        sparse_columns = None
-        if self.sparse_partition and s > 1:  # (s == 1 only when a round emptied all but one region)
-            sparse = self._sparse_partition(train_X, train_labels, partition, s)
-            if sparse is not None:
-                partition, sparse_columns = sparse
-                labels = partition.predict(X)
-        # regions emptied by the last round or by the sparse classifier: refit on the ones left
-        labels, s = self._drop_empty(labels, s)
-        if partition.n_regions != s:
-            columns = self._pcols if sparse_columns is None else sparse_columns
-            partition = fit_linear_partition(X, labels, s, C=self.classifier_C, columns=columns)
-            labels = partition.predict(X)
-            if s == 1:
-                sparse_columns = None
-        return labels, partition, sparse_columns
-
-    def _sparse_partition(self, X, labels, partition, s):
-        """``(classifier, columns)`` refitted on the columns its boundaries use, or None.
-
-        ``X, labels`` are the classifier's own training rows (the last refinement round's confident
-        samples, at most ``CLASSIFIER_ROWS``). A column is used when its weight in some boundary
-        normal ``w_i - w_j`` (standardised coordinates) reaches ``SPARSE_TOL`` of that normal's
-        largest weight. The reduced classifier is kept only if it misclassifies no more of those rows
-        than the full one, plus ``max(1, 0.1 %)`` of them; if it is refused, the columns under a tenth
-        of ``SPARSE_TOL`` alone are tried (a boundary with a small but real slope in one column keeps
-        that column and still drops the ones it does not use at all).
-        """
-        W, _ = partition.scores
-        sd = X.std(axis=0)
-        sd[sd == 0] = 1.0
-        weight = np.zeros(X.shape[1])  # largest relative weight of each column over the normals
-        for i in range(s):
-            for j in range(i + 1, s):
-                normal = np.abs(W[i] - W[j]) * sd
-                if normal.max() > 0:
-                    weight = np.maximum(weight, normal / normal.max())
-        allowed = np.zeros(X.shape[1], dtype=bool)
-        allowed[self._pcols if self._pcols is not None else slice(None)] = True
-        errors_full = None
-        tried = None
-        for tol in (SPARSE_TOL, SPARSE_TOL / 10):
-            used = allowed & (weight >= tol)
-            if not used.any() or used.sum() == allowed.sum() or (tried is not None and np.array_equal(used, tried)):
-                continue
-            tried = used
-            if errors_full is None:
-                errors_full = int(np.sum(partition.predict(X) != labels))
-            reduced = fit_linear_partition(X, labels, s, C=self.classifier_C, columns=np.flatnonzero(used))
-            if int(np.sum(reduced.predict(X) != labels)) <= errors_full + max(1, int(0.001 * labels.size)):
-                return reduced, np.flatnonzero(used)
-        return None
-
-    @staticmethod
-    def _informative(mask, logp, rng, limit: int = CLASSIFIER_ROWS):
-        """At most ``limit`` rows of ``mask`` for the classifier: the half nearest the current
-        boundaries (smallest gap between the two largest class scores) and a random half of the
-        rest. Far-away rows hardly move a near-separable logistic boundary."""
-        idx = np.flatnonzero(mask)
-        if idx.size <= limit or logp is None:
-            return mask
-        top2 = np.sort(logp[idx], axis=1)[:, -2:]
-        gap = top2[:, 1] - top2[:, 0]
-        order = np.argsort(gap)
-        near = idx[order[: limit // 2]]
-        rest = idx[order[limit // 2:]]
-        far = rng.choice(rest, limit - near.size, replace=False)
-        out = np.zeros_like(mask)
-        out[near] = True
-        out[far] = True
-        return out
-
-    @staticmethod
-    def _drop_empty(labels, s):
-        counts = np.bincount(labels, minlength=s)
-        keep = np.flatnonzero(counts > 0)
-        if keep.size == s:
-            return labels, s
-        warnings.warn(
-            f"{s - keep.size} of {s} regions received no training sample and were dropped; "
-            f"the model has {keep.size} regions", RegionWarning, stacklevel=3,
-        )
-        remap = np.full(s, -1)
-        remap[keep] = np.arange(keep.size)
-        return remap[labels], int(keep.size)
 
     # ------------------------------------------------------------------ prediction
     def _check_inputs(self, X, y=None, need_y=True):

@@ -124,6 +124,7 @@ class AlternatingSegmenter(Segmenter):
     """
 
     name = "alternating"
+    learns_partition = True
 
     def __init__(self, *, n_restarts: int | str = 4, gamma: float = 1.0, max_iter: int = 50,
                  anneal: tuple = ()):

@@ -18,6 +18,7 @@ vectorised (batched normal equations), so the method scales to 10^5 samples.
 from __future__ import annotations
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from hwpts.identification.segmentation.base import SegmentationResult, Segmenter, kmeans_labels, standardize
 
@@ -31,7 +32,8 @@ def local_features(X, y, n_neighbors: int):
     n, nf = Z.shape
     p = nf + 1
     c = int(min(max(n_neighbors, p + 1), n))
-    idx = NearestNeighbors(n_neighbors=c).fit(Z).kneighbors(Z, return_distance=False)
+    with threadpool_limits(limits=1, user_api="openmp"):  # see base.kmeans_labels
+        idx = NearestNeighbors(n_neighbors=c).fit(Z).kneighbors(Z, return_distance=False)
     P = np.concatenate([Z[idx], np.ones((n, c, 1))], axis=2)  # (n, c, p)
     Y = ys[idx]
     G = np.einsum("nci,ncj->nij", P, P)
@@ -56,6 +58,7 @@ class ClusteringSegmenter(Segmenter):
     """
 
     name = "clustering"
+    learns_partition = True
 
     def __init__(self, *, n_neighbors: int | None = None, n_init: int = 10):
         self.n_neighbors = n_neighbors

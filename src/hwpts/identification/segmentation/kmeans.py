@@ -14,6 +14,7 @@ from hwpts.identification.segmentation.base import SegmentationResult, Segmenter
 
 class KMeansSegmenter(Segmenter):
     name = "kmeans"
+    learns_partition = True
 
     def __init__(self, *, include_output: bool = False, n_init: int = 10):
         self.include_output = include_output

@@ -79,6 +79,9 @@ def _score_split(estimator, params, u, y, train, test, names=None, output_name=N
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         model.fit(u[train], y[train], names, output_name, breaks=breaks_of(train) or None)
+        if model.structure_.max_lag == 0:  # a static map: any rows, the free run is the prediction
+            sim = model.simulate(u[test], y[test])
+            return sim.score(y[test]), int(model.n_regions_)
         start, stop = int(test[0]), int(test[-1]) + 1
         sim = model.simulate(u[start:stop], y[start:stop])
     return sim.score(y[start:stop]), int(model.n_regions_)
@@ -130,7 +133,10 @@ class PWARXSearch(BaseEstimator):
         Number of blocks of :class:`BlockedSplit`, or any splitter yielding ``(train, test)`` index
         arrays with a contiguous ``test`` (``sklearn.model_selection.TimeSeriesSplit``,
         :class:`HoldoutSplit`). Default: 5 blocks (3 beyond 5,000 samples, where each block is
-        long enough to visit every regime), fewer (down to 2) when the record is short.
+        long enough to visit every regime), fewer (down to 2) when the record is short; for a static
+        map (no lagged signal in the regressor) a shuffled ``KFold`` instead, since the order of the
+        rows carries nothing and contiguous blocks of data sorted along an input would only test
+        extrapolation.
     methods : sequence of str
         Segmentation methods of the adaptive search.
     orders : None, "auto" or dict
@@ -222,12 +228,20 @@ class PWARXSearch(BaseEstimator):
                     f"{min_block} samples ({max_lag} initial conditions + {MIN_BLOCK}); give the model settings "
                     f"(orders, segmentation, regions) instead"
                 )
-            cv = BlockedSplit(k, min_block=min_block)
+            if max_lag == 0:
+                # a static map (no lagged signal): the order of the rows carries nothing, and
+                # contiguous blocks of a record sorted along an input would test extrapolation only
+                from sklearn.model_selection import KFold
+
+                seed = getattr(self.estimator, "random_state", None)
+                cv = KFold(k, shuffle=True, random_state=seed if isinstance(seed, (int, np.integer)) else 0)
+            else:
+                cv = BlockedSplit(k, min_block=min_block)
         elif isinstance(cv, (int, np.integer)) and not isinstance(cv, bool):
             cv = BlockedSplit(int(cv), min_block=min_block)
         splits = [(np.asarray(tr), np.asarray(te)) for tr, te in cv.split(np.zeros((n, 1)))]
         for train, test in splits:
-            if test.size <= max_lag + 1 or np.any(np.diff(test) != 1):
+            if max_lag > 0 and (test.size <= max_lag + 1 or np.any(np.diff(test) != 1)):
                 raise ParameterError(f"PWARXSearch: every test block must be contiguous and longer than "
                                      f"{max_lag + 1} samples (the initial conditions)")
         return splits
@@ -378,11 +392,14 @@ class PWARXSearch(BaseEstimator):
             model.fit(u, y, names, oname)
             fits = []
             for _, test in splits:
-                start, stop = int(test[0]), int(test[-1]) + 1
-                sim = model.simulate(u[start:stop], y[start:stop])
+                if model.structure_.max_lag == 0:
+                    rows = test
+                else:
+                    rows = slice(int(test[0]), int(test[-1]) + 1)
+                sim = model.simulate(u[rows], y[rows])
                 if sim.diverged:
                     return None, "the refit on all data diverges in free run on a block"
-                fits.append(sim.score(y[start:stop]))
+                fits.append(sim.score(y[rows]))
         if np.mean(fits) < cv_mean - self.refit_margin:
             return None, (f"refit on all data: block fit {np.mean(fits):.1f} % is more than {self.refit_margin} "
                           f"points below the cross-validated {cv_mean:.1f} %")

@@ -1,0 +1,185 @@
+"""The partition learner: labels -> polyhedral regions (eq. 9), with boundary refinement.
+
+A segmentation method gives every training row a region label; the learner turns the labels into
+a multicategory linear classifier (polyhedra ``{x : H_i x + g_i <= 0}``, eq. 9) and then refines the
+boundaries: each round fits the local models (eq. 17, trimming outliers), scores every row against
+every mode with ``cost_ik = r_ik^2 / sigma^2 - log p_i(x_k)`` (residual plus the classifier's
+confidence, which separates modes with equal parameters), and refits the classifier on the rows
+whose best mode wins by ``confidence_margin``. Ambiguous rows near a boundary carry no information
+about where it lies, so they are left to the classifier. Optionally (``sparse``) the columns the
+boundaries hardly use are dropped (:meth:`PartitionLearner.sparse_partition`).
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+
+from hwpts.identification.partition.polyhedra import fit_linear_partition
+
+__all__ = ["PartitionLearner", "drop_empty_regions", "TRIM"]
+
+TRIM = 3.0  # outlier threshold (robust std) of the local least squares of learned partitions
+
+
+def drop_empty_regions(labels, s):
+    """Labels renumbered without the regions that hold no row, and the number left (with a
+    :class:`~hwpts.identification.local_models.RegionWarning` when some were dropped)."""
+    from hwpts.identification.local_models import RegionWarning
+
+    counts = np.bincount(labels, minlength=s)
+    keep = np.flatnonzero(counts > 0)
+    if keep.size == s:
+        return labels, s
+    warnings.warn(
+        f"{s - keep.size} of {s} regions received no training sample and were dropped; "
+        f"the model has {keep.size} regions", RegionWarning, stacklevel=3,
+    )
+    remap = np.full(s, -1)
+    remap[keep] = np.arange(keep.size)
+    return remap[labels], int(keep.size)
+
+
+class PartitionLearner:
+    """Region classifier and boundary refinement (module doc).
+
+    Parameters
+    ----------
+    refinement_rounds : int
+        Boundary refinement rounds (0: the classifier of the labels as they are).
+    C : float
+        Inverse regularisation of the multinomial logistic classifier.
+    ridge : float
+        Ridge penalty of the local least squares inside the rounds.
+    sparse : bool
+        Drop the columns the boundaries hardly use (see :meth:`sparse_partition`).
+    confidence_margin : float
+        Cost margin by which a row's best mode must win for the row to train the classifier.
+    classifier_rows : int
+        Most rows the classifier is refitted on in a round (half nearest the boundaries).
+    sparse_tol : float
+        A column whose boundary weight is below this share of the largest is dropped.
+    trim : float
+        Outlier threshold (robust standard deviations) of the local least squares.
+    random_state : int or None
+    """
+
+    def __init__(self, *, refinement_rounds: int = 3, C: float = 1e4, ridge: float = 0.0, sparse: bool = True,
+                 confidence_margin: float = 4.0, classifier_rows: int = 6000, sparse_tol: float = 0.05,
+                 trim: float = TRIM, random_state=None):
+        self.refinement_rounds = refinement_rounds
+        self.C = C
+        self.ridge = ridge
+        self.sparse = sparse
+        self.confidence_margin = confidence_margin
+        self.classifier_rows = classifier_rows
+        self.sparse_tol = sparse_tol
+        self.trim = trim
+        self.random_state = random_state
+
+    def learn(self, X, y, labels, s, constant=True, columns=None):
+        """``(labels, partition, sparse_columns)`` for the rows ``X`` labelled ``labels``
+        (``0 .. s-1``); ``columns``: regressor columns the classifier may use (default all);
+        ``sparse_columns`` is None unless the sparse step dropped some."""
+        from hwpts.identification.local_models import fit_local_models
+
+        labels = np.asarray(labels, dtype=np.int64)
+        partition = fit_linear_partition(X, labels, s, C=self.C, columns=columns)
+        train_X, train_labels = X, labels
+        labels = partition.predict(X)
+        rounds = self.refinement_rounds if s > 1 else 0
+        p = X.shape[1] + 1
+        rng = np.random.default_rng(self.random_state)
+        for _ in range(rounds):
+            labels, s = drop_empty_regions(labels, s)
+            if s == 1:
+                break
+            local = fit_local_models(X, y, labels, s, constant, ("affine",) * s, self.ridge, warn=False, trim=self.trim)
+            R = local.residuals(X, y) ** 2
+            assigned = R[np.arange(len(y)), labels]
+            sigma2 = float(np.median(assigned)) / 0.4549 + 1e-12 * (np.var(y) + 1e-300)
+            logp = partition.log_proba(X) if partition.n_regions == s else None
+            cost = R / sigma2 - (logp if logp is not None else 0.0)
+            order = np.sort(cost, axis=1)
+            proposal = np.argmin(cost, axis=1)
+            confident = (order[:, 1] - order[:, 0]) > self.confidence_margin
+            if np.bincount(proposal[confident], minlength=s).min() < p:
+                confident[:] = True
+            confident = self._informative(confident, logp, rng)
+            train_X, train_labels = X[confident], proposal[confident]
+            partition = fit_linear_partition(train_X, train_labels, s, C=self.C, columns=columns)
+            new_labels = partition.predict(X)
+            if np.array_equal(new_labels, labels):
+                break
+            labels = new_labels
+        sparse_columns = None
+        if self.sparse and s > 1:  # (s == 1 only when a round emptied all but one region)
+            sparse = self.sparse_partition(train_X, train_labels, partition, s, columns)
+            if sparse is not None:
+                partition, sparse_columns = sparse
+                labels = partition.predict(X)
+        # regions emptied by the last round or by the sparse classifier: refit on the ones left
+        labels, s = drop_empty_regions(labels, s)
+        if partition.n_regions != s:
+            cols = columns if sparse_columns is None else sparse_columns
+            partition = fit_linear_partition(X, labels, s, C=self.C, columns=cols)
+            labels = partition.predict(X)
+            if s == 1:
+                sparse_columns = None
+        return labels, partition, sparse_columns
+
+    def sparse_partition(self, X, labels, partition, s, columns=None):
+        """``(classifier, columns)`` refitted on the columns its boundaries use, or None.
+
+        ``X, labels`` are the classifier's own training rows (the last refinement round's confident
+        rows). A column is used when its weight in some boundary normal ``w_i - w_j`` (standardised
+        coordinates) reaches ``sparse_tol`` of that normal's largest weight. The reduced classifier
+        is kept only if it misclassifies no more of those rows than the full one, plus
+        ``max(1, 0.1 %)`` of them; if it is refused, the columns under a tenth of ``sparse_tol``
+        alone are tried (a boundary with a small but real slope in one column keeps that column and
+        still drops the ones it does not use at all).
+        """
+        W, _ = partition.scores
+        sd = X.std(axis=0)
+        sd[sd == 0] = 1.0
+        weight = np.zeros(X.shape[1])  # largest relative weight of each column over the normals
+        for i in range(s):
+            for j in range(i + 1, s):
+                normal = np.abs(W[i] - W[j]) * sd
+                if normal.max() > 0:
+                    weight = np.maximum(weight, normal / normal.max())
+        allowed = np.zeros(X.shape[1], dtype=bool)
+        allowed[columns if columns is not None else slice(None)] = True
+        errors_full = None
+        tried = None
+        for tol in (self.sparse_tol, self.sparse_tol / 10):
+            used = allowed & (weight >= tol)
+            if not used.any() or used.sum() == allowed.sum() or (tried is not None and np.array_equal(used, tried)):
+                continue
+            tried = used
+            if errors_full is None:
+                errors_full = int(np.sum(partition.predict(X) != labels))
+            reduced = fit_linear_partition(X, labels, s, C=self.C, columns=np.flatnonzero(used))
+            if int(np.sum(reduced.predict(X) != labels)) <= errors_full + max(1, int(0.001 * labels.size)):
+                return reduced, np.flatnonzero(used)
+        return None
+
+    def _informative(self, mask, logp, rng):
+        """At most ``classifier_rows`` rows of ``mask`` for the classifier: the half nearest the
+        current boundaries (smallest gap between the two largest class scores) and a random half
+        of the rest. Far-away rows hardly move a near-separable logistic boundary."""
+        limit = int(self.classifier_rows)
+        idx = np.flatnonzero(mask)
+        if idx.size <= limit or logp is None:
+            return mask
+        top2 = np.sort(logp[idx], axis=1)[:, -2:]
+        gap = top2[:, 1] - top2[:, 0]
+        order = np.argsort(gap)
+        near = idx[order[: limit // 2]]
+        rest = idx[order[limit // 2:]]
+        far = rng.choice(rest, limit - near.size, replace=False)
+        out = np.zeros_like(mask)
+        out[near] = True
+        out[far] = True
+        return out
