@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: install reproduce test bench readme clean
+.PHONY: install reproduce test bench readme readme-control clean
 
 install: $(STAMP)
 
@@ -26,5 +26,9 @@ bench: install
 readme: reproduce
 	$(BIN)/python tools/update_readme.py results
 
+readme-control: install
+	$(BIN)/hwpts control run --scenario turbulence-a --seed 0 --out results-control
+	$(BIN)/python tools/update_readme_control.py results-control
+
 clean:
-	rm -rf $(VENV) results .pytest_cache .hypothesis
+	rm -rf $(VENV) results results-control .pytest_cache .hypothesis

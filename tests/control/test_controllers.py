@@ -141,3 +141,21 @@ def test_mpc_rejects_a_pump_step_without_failed_solves(paper_model_doc):
     assert c.solves == sc.time.size and c.failed_solves == 0
     assert m["recovery_time_s"] is not None and m["recovery_time_s"] < 1.5
     assert m["rms_error_percent"] < 1.0
+
+
+def test_hybrid_mpc_plans_with_region_binaries(paper_model_doc):
+    """The MILP hybrid MPC holds the speed through a pump step with no failed solve (4 s record)."""
+    from hwpts.control.controllers import make_controller
+    from hwpts.control.loop import run_loop
+    from hwpts.control.metrics import compute_metrics
+    from hwpts.control.scenarios import build_scenario
+
+    doc, r_hat, ts = paper_model_doc
+    bank = ModelBank(doc, ts)
+    sc = build_scenario("pump-step", duration=5.0)
+    c = make_controller("hybrid-mpc", bank, r_hat, sc)
+    result = run_loop(sc, c)
+    m = compute_metrics(sc, result, True)
+    assert c.solves == sc.time.size and c.failed_solves == 0
+    assert set(np.unique(c.planned_regions)) <= set(bank.control_regions)
+    assert m["recovery_time_s"] is not None and m["recovery_time_s"] < 1.5

@@ -62,6 +62,8 @@ def loop_figure(runs: dict, title: str, window=None) -> bytes:
             lo, hi = np.nanmin(cols["motor_a_speed_rpm"][sel]), np.nanmax(cols["motor_a_speed_rpm"][sel])
             ax.fill_between(t[sel], lo, hi, where=unreach, color="tab:red", alpha=0.08, lw=0, label="out of reach")
         ax.set_title(name, fontsize=10)
+        if window is not None:
+            ax.set_ylim(float(np.min(sp)) * 0.96, float(np.max(sp)) * 1.04)
         if j == 0:
             ax.set_ylabel("speed [r/min]")
             ax.legend(fontsize=7, loc="lower left")
@@ -90,6 +92,22 @@ def loop_figure(runs: dict, title: str, window=None) -> bytes:
     fig.suptitle(title, fontsize=11)
     fig.tight_layout()
     return _png(fig)
+
+
+def zoom_window(columns: dict, length: float = 60.0):
+    """A window of ``length`` seconds where the set-point stays within reach and the pump speed varies
+    most (for a readable zoom of a long record); None when the record is not longer than that."""
+    t = columns["time_s"]
+    if t[-1] <= length:
+        return None
+    best, best_score = None, -1.0
+    for start in np.arange(0.0, t[-1] - length + 1e-9, length / 2):
+        sel = (t >= start) & (t <= start + length)
+        reach = columns["reachable"][sel]
+        score = float(np.std(columns["pump_speed_command_rpm"][sel])) if reach.min() > 0.5 else -1.0
+        if score > best_score:
+            best, best_score = (float(start), float(start + length)), score
+    return best
 
 
 def render_control_report(summary: dict, figures: dict[str, bytes]) -> str:

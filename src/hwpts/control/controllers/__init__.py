@@ -8,6 +8,7 @@ without the hysteresis inverse.
 from __future__ import annotations
 
 from hwpts.control.controllers.base import Controller, HysteresisInverse, PIGains, PILaw
+from hwpts.control.controllers.hybrid_mpc import HybridMPCController
 from hwpts.control.controllers.mpc import MPCController
 from hwpts.control.controllers.pi import PIController
 from hwpts.control.controllers.reference import ReferenceController
@@ -17,10 +18,11 @@ from hwpts.errors import ParameterError
 BASE_NAMES = ("pi", "scheduled", "mmac", "mpc", "hybrid-mpc", "reference")
 CONTROLLER_NAMES = tuple(n for b in BASE_NAMES for n in (b, f"{b}-no-inverse"))
 MODEL_BASED = ("pi", "scheduled", "mmac", "mpc", "hybrid-mpc")
-AVAILABLE = ("pi", "scheduled", "mmac", "mpc", "reference")
+AVAILABLE = BASE_NAMES
 """Base names implemented so far."""
 
-_CLASSES = {"pi": PIController, "scheduled": ScheduledController, "mmac": MMACController, "mpc": MPCController}
+_CLASSES = {"pi": PIController, "scheduled": ScheduledController, "mmac": MMACController, "mpc": MPCController,
+            "hybrid-mpc": HybridMPCController}
 
 
 def parse_names(text: str) -> list[str]:
@@ -52,6 +54,6 @@ def make_controller(name: str, bank, half_width: float, scenario, sample_time: f
     return c
 
 
-__all__ = ["AVAILABLE", "BASE_NAMES", "CONTROLLER_NAMES", "MODEL_BASED", "Controller", "HysteresisInverse",
+__all__ = ["AVAILABLE", "BASE_NAMES", "CONTROLLER_NAMES", "MODEL_BASED", "Controller", "HybridMPCController", "HysteresisInverse",
            "MMACController", "MPCController", "PIController", "PIGains", "PILaw", "ReferenceController", "ScheduledController",
            "make_controller", "parse_names"]

@@ -138,6 +138,10 @@ class MPCController(Controller):
         # dummy last entries are dropped by _predict)
         y_model = np.append(self._model_history(0), 0.0)
         u1_hist = np.append(u1_hist, 0.0)
+        return self.inverse(float(self._optimize(setpoint, y_model, u1_hist, u2_hist)))
+
+    def _optimize(self, setpoint, y_model, u1_hist, u2_hist) -> float:
+        """The plan's first move (effective valve voltage) from the QP on the predicted region sequence."""
         lo, hi = self.inverse.effective_limits
         u_prev = self.inverse.effective
         # the region sequence along the previous plan, then an affine prediction in the moves
@@ -173,7 +177,7 @@ class MPCController(Controller):
         if np.all(free >= lower) and np.all(free <= upper):
             self.solves += 1
             self.plan = free  # the bounds are inactive: the QP's solution is the unconstrained one
-            return self.inverse(float(self.plan[0]))
+            return self.plan[0]
         self.solves += 1
         try:
             sol = lsq_linear(a, b, bounds=(lower, upper), method="bvls")
@@ -185,4 +189,4 @@ class MPCController(Controller):
         else:
             self.failed_solves += 1
             self.plan = np.clip(self.plan, lower, upper)
-        return self.inverse(float(self.plan[0]))
+        return self.plan[0]
