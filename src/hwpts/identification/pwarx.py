@@ -95,8 +95,8 @@ class PWARX(BaseEstimator):
         Learned segmentations (clustering, alternating, k-means) label at most this many regressor
         rows drawn at random (seeded); a linear classifier extends their labels to every row, and
         the boundary refinement and the local least squares use every row. The segmentation's cost
-        grows with the rows, its labels' quality hardly beyond a few thousand (default 5,000;
-        ``None``: all rows).
+        grows with the rows (default ``None``: all rows; :class:`PWARXSearch` uses 5,000 for its
+        cross-validation fits, then refits the winner as given).
     polish : bool
         Refine the local parameters by minimising the free-run simulation error on the training
         data (partition fixed; see :mod:`hwpts.identification.polish`), kept only if better.
@@ -123,7 +123,7 @@ class PWARX(BaseEstimator):
     def __init__(self, output_order=1, input_order=1, input_delay=1, n_regions=2,
                  segmentation="clustering", hyperplanes=None, region_models=None, constant=True,
                  ridge=0.0, refinement_rounds=3, classifier_C=1e4, segmentation_params=None,
-                 polish=False, partition_columns=None, sparse_partition=True, max_rows=5000,
+                 polish=False, partition_columns=None, sparse_partition=True, max_rows=None,
                  random_state=None):
         self.output_order = output_order
         self.input_order = input_order

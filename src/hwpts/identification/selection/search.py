@@ -22,6 +22,7 @@ Two ways to say what to try:
   2. **regions**: for each kept order, one region (ARX), then 2, 3, ... regions with every method
      of ``methods``; the count grows until ``patience`` successive counts fail to improve the best
      score, or until every region would hold fewer than ``3 (p + 1)`` rows;
+     Learned segmentations label at most 5,000 rows in these fits (``PWARX(max_rows=...)``).
      A candidate whose running mean over the blocks falls 10 points below the best so far is
      not scored on its remaining blocks (racing, Maron & Moore 1994): it could not win;
   3. **choice**: the best score wins, but a candidate within ``tolerance`` points with fewer
@@ -73,9 +74,14 @@ def expand_grid(grid) -> list[dict]:
     return out
 
 
+FOLD_MAX_ROWS = 5000  # rows a learned segmentation labels in a cross-validation fit (PWARX max_rows)
+
+
 def _score_split(estimator, params, u, y, train, test, names=None, output_name=None):
     """Free-run fit % of ``params`` fitted on ``train``, simulated over ``test`` (nan if diverged)."""
     model = clone(estimator).set_params(**params)
+    if model.max_rows is None:  # the folds label a subsample; the winner's refit uses every row
+        model.set_params(max_rows=FOLD_MAX_ROWS)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         model.fit(u[train], y[train], names, output_name, breaks=breaks_of(train) or None)
