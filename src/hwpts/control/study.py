@@ -144,7 +144,7 @@ def run_study(model_doc: dict, model_sample_time: float, half_width: float, n_pl
                 raise DataError(f"--scheduler {scheduler!r}: cannot reach a Dask scheduler there ({error})") from None
         else:
             cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
-                                   dashboard_address=None)
+                                   dashboard_address=":0")
             client = Client(cluster)
         try:
             doc = client.scatter(model_doc, broadcast=True)
