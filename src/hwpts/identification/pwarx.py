@@ -370,6 +370,14 @@ class PWARX(BaseEstimator):
         check_is_fitted(self, "theta_")
         return [mode_state_space(self.structure_, th) for th in self.theta_]
 
+    def to_control(self, dt=None) -> list:
+        """One python-control ``StateSpace`` per mode (the offset as the last input, held at 1);
+        see :func:`hwpts.identification.analysis.to_control` (needs ``hwpts[control]``)."""
+        from hwpts.identification.analysis import to_control
+
+        check_is_fitted(self, "theta_")
+        return to_control(self, dt)
+
     def summary(self) -> dict:
         """JSON-ready description: orders, regions, per-mode sample counts and pole moduli."""
         check_is_fitted(self, "theta_")

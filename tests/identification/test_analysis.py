@@ -1,0 +1,44 @@
+"""Export to python-control: each mode's response equals hwpts's free run restricted to that mode."""
+
+import numpy as np
+import pytest
+
+from hwpts.identification import PWARX, RegionPartition
+from hwpts.identification.analysis import mode_initial_state
+from hwpts.identification.synthetic import make_system
+
+control = pytest.importorskip("control")
+
+
+@pytest.mark.parametrize("nk", [1, 0])
+def test_each_mode_matches_python_control(nk):
+    d = make_system(5, rng=0, n=3000)
+    model = PWARX(2, 2, nk, n_regions=3, segmentation="alternating", random_state=0).fit(d.inputs, d.output)
+    systems = model.to_control(dt=0.01)
+    assert len(systems) == 3 and all(s.dt == 0.01 for s in systems)
+    st = model.structure_
+    rng = np.random.default_rng(1)
+    n = 300
+    u = rng.uniform(-1, 1, (n, 2))
+    y0 = np.array([0.3, -0.2, 0.1])
+    m = st.max_lag
+    for i, sys in enumerate(systems):
+        single = PWARX.from_parts(st, RegionPartition.single(st.n_features), model.theta_[i:i + 1])
+        for forced in (True, False):
+            uu = u if forced else np.zeros_like(u)
+            ref = single.simulate(uu, initial_output=y0[:m]).output
+            x0 = mode_initial_state(st, uu, np.concatenate([y0[:m], np.zeros(n - m)]), m)
+            U = np.vstack([uu[m:].T, np.ones(n - m)])
+            resp = control.forced_response(sys, T=np.arange(n - m) * 0.01, U=U, X0=x0)
+            np.testing.assert_allclose(np.ravel(resp.outputs), ref[m:], rtol=0, atol=1e-9 * max(1.0, np.abs(ref).max()))
+
+
+def test_to_control_rejects_a_bad_sample_time():
+    from hwpts.errors import ParameterError
+
+    d = make_system(5, rng=0, n=600)
+    model = PWARX(2, 2, 1, n_regions=1, segmentation="average").fit(d.inputs, d.output)
+    with pytest.raises(ParameterError, match="dt must be"):
+        model.to_control(dt=-1.0)
+    (sys,) = model.to_control()
+    assert sys.dt is True and list(sys.input_labels) == ["u1", "u2", "offset"]
