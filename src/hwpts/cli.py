@@ -8,7 +8,10 @@ line on stderr with exit status 2 (no traceback).
 from __future__ import annotations
 
 import argparse
+import os
+import signal
 import sys
+import threading
 from collections.abc import Sequence
 
 from hwpts import __version__
@@ -44,20 +47,55 @@ def build_parser() -> ArgumentParser:
     return parser
 
 
+INPUT_ARGS = ("data", "model", "inputs")  # arguments that name files a command reads
+
+
+def _check_outputs(args) -> None:
+    """An output that is one of the command's inputs is refused (it would destroy the input)."""
+    out = getattr(args, "out", None)
+    if out is None or str(out) == "-":
+        return
+    target = os.path.realpath(out)
+    for name in INPUT_ARGS:
+        source = getattr(args, name, None)
+        if source is not None and os.path.realpath(source) == target:
+            raise UsageError(f"--out {str(out)!r} is the {name} file {str(source)!r}: writing it would destroy "
+                             f"the input; choose another output path")
+
+
+def _sigterm(signum, frame):  # pragma: no cover - exercised in a subprocess test
+    raise KeyboardInterrupt
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the command line; return the exit status (0 ok, 2 bad argument, input or failure)."""
+    """Run the command line; return the exit status (0 ok, 2 bad argument, input or failure).
+
+    SIGTERM is handled as Ctrl-C: the run stops, temporary files and staging folders are removed,
+    earlier outputs stay intact, exit status 130 and one line.
+    """
     parser = build_parser()
+    previous = None
+    if threading.current_thread() is threading.main_thread():
+        previous = signal.signal(signal.SIGTERM, _sigterm)
     try:
         args = parser.parse_args(argv)
+        _check_outputs(args)
         return int(args.handler(args) or EXIT_OK)
     except HwptsError as error:
         print(f"hwpts: error: {error}", file=sys.stderr)
         return EXIT_USAGE
+    except OSError as error:
+        if isinstance(error, BrokenPipeError):
+            return EXIT_OK
+        where = f"{error.filename!s}: " if error.filename else ""
+        print(f"hwpts: error: {where}{error.strerror or error}", file=sys.stderr)
+        return EXIT_USAGE
     except KeyboardInterrupt:
         print("hwpts: interrupted", file=sys.stderr)
         return 130
-    except BrokenPipeError:
-        return EXIT_OK
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -7,26 +7,63 @@ from __future__ import annotations
 
 import contextlib
 import os
+import stat
 import tempfile
 from pathlib import Path
+
+from hwpts.errors import DataError
+
+
+def umask_mode(base: int = 0o666) -> int:
+    """``base`` with the process umask applied (what ``open()`` would create)."""
+    mask = os.umask(0)
+    os.umask(mask)
+    return base & ~mask
+
+
+def check_output_path(path: str | os.PathLike, what: str = "--out") -> Path:
+    """Refuse an output that is a folder, a symbolic link, a device or a FIFO (never replaced)."""
+    target = Path(path)
+    if target.is_symlink():
+        raise DataError(f"{what} {str(target)!r}: is a symbolic link; hwpts never replaces a link, "
+                        f"give the path of a regular file")
+    if target.exists():
+        mode = target.stat().st_mode
+        if stat.S_ISDIR(mode):
+            raise DataError(f"{what} {str(target)!r}: is a folder, expected a file path")
+        if not stat.S_ISREG(mode):
+            raise DataError(f"{what} {str(target)!r}: is a device, FIFO or socket, not a regular file; "
+                            f"hwpts never replaces one")
+    return target
 
 
 @contextlib.contextmanager
 def atomic_path(path: str | os.PathLike, suffix: str | None = None):
     """Yield a temporary path beside ``path``; on success rename it onto ``path``.
 
-    On any exception the temporary file is removed and ``path`` is left untouched.
+    On any exception (Ctrl-C and SIGTERM included) the temporary file is removed and ``path`` is
+    left untouched. The file gets the permissions ``open()`` would give it (the umask's). A path
+    that is a folder, a link, a device or a FIFO is refused; an operating-system error becomes a
+    :class:`DataError` naming the path.
     """
-    target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(
-        prefix=f".{target.name}.", suffix=suffix if suffix is not None else target.suffix + ".tmp",
-        dir=target.parent,
-    )
-    os.close(fd)
+    target = check_output_path(path)
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(
+            prefix=f".{target.name}.", suffix=suffix if suffix is not None else target.suffix + ".tmp",
+            dir=target.parent,
+        )
+        os.close(fd)
+    except OSError as error:
+        raise DataError(f"--out {str(target)!r}: cannot write there ({error.strerror or error})") from None
     try:
         yield Path(tmp)
+        os.chmod(tmp, umask_mode())
         os.replace(tmp, target)
+    except OSError as error:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(tmp)
+        raise DataError(f"--out {str(target)!r}: cannot write there ({error.strerror or error})") from None
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)

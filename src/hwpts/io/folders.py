@@ -11,6 +11,7 @@ import tempfile
 from pathlib import Path
 
 from hwpts.errors import DataError
+from hwpts.io.atomic import umask_mode
 
 
 def check_replaceable(path: str | os.PathLike, schema: str, marker: str = "summary.json") -> None:
@@ -33,15 +34,48 @@ def check_replaceable(path: str | os.PathLike, schema: str, marker: str = "summa
         )
 
 
+PID_FILE = ".hwpts-pid"  # the process writing a staging folder
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OSError):
+        return True
+    return True
+
+
+def _remove_stale_stages(out: Path) -> None:
+    """Staging folders of ``out`` left by a run that was killed (its process is gone)."""
+    for stale in out.parent.glob(f".{out.name}.new-*"):
+        try:
+            pid = int((stale / PID_FILE).read_text(encoding="utf-8").strip())
+        except (OSError, ValueError):
+            pid = None
+        if pid is None or not _alive(pid):
+            shutil.rmtree(stale, ignore_errors=True)
+    for stale in out.parent.glob(f".{out.name}.old-*"):
+        shutil.rmtree(stale, ignore_errors=True)
+
+
 @contextlib.contextmanager
 def staged_folder(path: str | os.PathLike, schema: str):
     """Yield a fresh staging folder beside ``path``; on success it replaces ``path`` as a whole."""
     out = Path(path)
     check_replaceable(out, schema)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    stage = Path(tempfile.mkdtemp(prefix=f".{out.name}.new-", dir=out.parent))
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        _remove_stale_stages(out)
+        stage = Path(tempfile.mkdtemp(prefix=f".{out.name}.new-", dir=out.parent))
+        (stage / PID_FILE).write_text(str(os.getpid()), encoding="utf-8")
+    except OSError as error:
+        raise DataError(f"--out {str(out)!r}: cannot write there ({error.strerror or error})") from None
     try:
         yield stage
+        (stage / PID_FILE).unlink()
+        os.chmod(stage, umask_mode(0o777))
     except BaseException:
         shutil.rmtree(stage, ignore_errors=True)
         raise
