@@ -90,6 +90,18 @@ def main(argv: Sequence[str] | None = None) -> int:
         where = f"{error.filename!s}: " if error.filename else ""
         print(f"hwpts: error: {where}{error.strerror or error}", file=sys.stderr)
         return EXIT_USAGE
+    except MemoryError:
+        print("hwpts: error: not enough memory for this run; use a smaller grid or fewer samples", file=sys.stderr)
+        return EXIT_USAGE
+    except (ArithmeticError, ValueError) as error:
+        import numpy as np
+
+        if not isinstance(error, (ArithmeticError, np.linalg.LinAlgError)):
+            raise
+        # a numerical failure (singular or non-convergent linear algebra, overflow): one line
+        print(f"hwpts: error: numerical failure ({type(error).__name__}: {error}); check the data's scale "
+              f"and the options (e.g. --ridge)", file=sys.stderr)
+        return EXIT_USAGE
     except KeyboardInterrupt:
         print("hwpts: interrupted", file=sys.stderr)
         return 130

@@ -104,3 +104,21 @@ def test_a_killed_runs_staging_folder_is_removed_by_the_next_run(tmp_path):
         (stage / "summary.json").write_text('{"schema": "test/1"}')
     assert not stale.exists() and (out / "summary.json").exists()
     assert not (out / PID_FILE).exists()
+
+
+@pytest.mark.parametrize("extra, match", [
+    (["--seed", "-1"], "argument --seed: expected a whole number >= 0, got '-1'"),
+    (["--ridge", "1e308"], "numerical failure"),
+    (["--ridge", "-1"], "argument --ridge"),
+])
+def test_values_checked_at_the_edge(tmp_path, data_csv, capsys, extra, match):
+    out = tmp_path / "m.json"
+    _one_line_error(capsys, ["identify", str(data_csv), *FIT, *extra, "--out", str(out)], match)
+    assert not out.exists()
+
+
+def test_a_sweep_grid_too_large_for_memory_is_refused_before_allocating(tmp_path, capsys):
+    out = tmp_path / "s.csv"
+    _one_line_error(capsys, ["plant", "sweep", "--out", str(out), "--voltages", "1.2:3.8:50000",
+                             "--pump-speeds", "200:1000:50000"], "2,500,000,000 operating points")
+    assert not out.exists()

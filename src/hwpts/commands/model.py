@@ -275,6 +275,7 @@ def _common_data_args(parser):
 
 
 def register(subparsers):
+    from hwpts.commands._args import non_negative_float, non_negative_int
     from hwpts.identification.segmentation import SEGMENTATION_METHODS
 
     p = subparsers.add_parser(
@@ -307,9 +308,10 @@ def register(subparsers):
     p.add_argument("--all-partition-columns", action="store_true",
                    help="keep every allowed column in a learned partition (default: drop the columns its "
                         "boundaries hardly use)")
-    p.add_argument("--ridge", type=float, default=0.0, help="ridge penalty of the local least squares")
+    p.add_argument("--ridge", type=non_negative_float, default=0.0,
+                   help="ridge penalty of the local least squares (relative to the regressors' scale; default 0)")
     p.add_argument("--polish", action="store_true", help="refine parameters on the free-run simulation error")
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--seed", type=non_negative_int, default=0, metavar="N", help="random seed (default 0)")
     p.add_argument("--out", required=True, metavar="MODEL.json", help="model file to write")
     _common_data_args(p)
     p.set_defaults(handler=cmd_identify)

@@ -7,6 +7,7 @@ import json
 import numpy as np
 
 from hwpts.commands._args import finite_float, grid, non_negative_float, non_negative_int, output_file
+from hwpts.errors import ParameterError
 
 INPUT_COLUMNS = ("time_s", "valve_voltage_v", "pump_speed_rpm")
 """Columns of an --inputs CSV for ``hwpts plant simulate``."""
@@ -81,11 +82,21 @@ def steady_state_command(args) -> int:
     return 0
 
 
+MAX_SWEEP_POINTS = 5_000_000  # operating points of one sweep (about 1.5 GiB of work arrays)
+
+
 def sweep_command(args) -> int:
     from hwpts.experiments.sweeps import sweep_columns
     from hwpts.io.datasets import write_csv
     from hwpts.plant import PlantParameters, sweep
 
+    points = int(args.voltages[2]) * int(args.pump_speeds[2])
+    if points > MAX_SWEEP_POINTS:
+        # about 40 float64 arrays per point (states, pressures, both sweeps, the CSV columns)
+        raise ParameterError(
+            f"--voltages x --pump-speeds: {points:,} operating points would need about "
+            f"{points * 40 * 8 / 2**30:.0f} GiB; at most {MAX_SWEEP_POINTS:,} points are accepted"
+        )
     voltages = np.linspace(*args.voltages)
     pumps = np.linspace(*args.pump_speeds)
     result = sweep(PlantParameters.paper(), voltages, pumps)
