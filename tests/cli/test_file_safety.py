@@ -122,3 +122,14 @@ def test_a_sweep_grid_too_large_for_memory_is_refused_before_allocating(tmp_path
     _one_line_error(capsys, ["plant", "sweep", "--out", str(out), "--voltages", "1.2:3.8:50000",
                              "--pump-speeds", "200:1000:50000"], "2,500,000,000 operating points")
     assert not out.exists()
+
+
+def test_validate_json_is_strict_when_the_free_run_diverges():
+    """JSON has no NaN or Infinity: a diverged fit is null."""
+    from hwpts.commands._args import json_text
+
+    text = json_text({"fit_percent": float("nan"), "rmse": float("inf"), "n": 3, "fits": [1.0, float("-inf")]})
+    import json
+
+    assert json.loads(text) == {"fit_percent": None, "rmse": None, "n": 3, "fits": [1.0, None]}
+    assert "NaN" not in text and "Infinity" not in text

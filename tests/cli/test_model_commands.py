@@ -231,3 +231,23 @@ def test_hyperplane_with_a_negative_first_coefficient(tmp_path, data_csv, capsys
     assert main(["identify", str(data_csv), *IDENTIFY, "--hyperplane=-1,0,0.2", "--out", str(out)]) == 0
     summary = json.loads(capsys.readouterr().out)
     assert summary["segmentation"] == "hyperplane" and summary["n_regions"] == 2
+
+
+def test_cli_segmentation_names_match_the_registry():
+    """`hwpts identify --segmentation` lists the registry's names without importing the library."""
+    from hwpts.commands.model import SEGMENTATION_NAMES
+    from hwpts.identification.segmentation import SEGMENTATION_METHODS
+
+    assert sorted(SEGMENTATION_NAMES) == sorted(SEGMENTATION_METHODS)
+
+
+def test_help_does_not_import_the_numerical_libraries():
+    import subprocess
+    import sys
+
+    code = ("import sys; from hwpts.cli import main\n"
+            "try:\n    main(['--help'])\nexcept SystemExit:\n    pass\n"
+            "heavy = [m for m in ('sklearn', 'scipy', 'numba', 'matplotlib') if m in sys.modules]\n"
+            "print(heavy); sys.exit(1 if heavy else 0)")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stdout + proc.stderr

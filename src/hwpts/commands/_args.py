@@ -4,6 +4,7 @@ was expected and what was received (argparse prefixes the argument's name)."""
 from __future__ import annotations
 
 import argparse
+import json
 import math
 from pathlib import Path
 
@@ -65,3 +66,21 @@ def output_file(text: str) -> Path:
     if path.is_dir():
         raise argparse.ArgumentTypeError(f"expected a file path, got the folder {text!r}")
     return path
+
+
+def _finite(obj):
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, dict):
+        return {k: _finite(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_finite(v) for v in obj]
+    if hasattr(obj, "item") and hasattr(obj, "dtype"):  # numpy scalars
+        return _finite(obj.item())
+    return obj
+
+
+def json_text(obj, indent: int | None = 2) -> str:
+    """Strict JSON for standard output: a value that is not a finite number (a diverged fit) is
+    ``null``, never ``NaN`` or ``Infinity``, which JSON does not have."""
+    return json.dumps(_finite(obj), indent=indent, allow_nan=False)

@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-import json
 import time
 import warnings
 
 import numpy as np
 
+from hwpts.commands._args import json_text
 from hwpts.errors import DataError, ParameterError, SimulationError
 
 
@@ -183,7 +183,7 @@ def cmd_identify(args) -> int:
     if notes:
         summary["warnings"] = notes
     save_model(model, args.out)
-    print(json.dumps(summary, indent=2))
+    print(json_text(summary))
     return 0
 
 
@@ -227,7 +227,7 @@ def cmd_validate(args) -> int:
     model, data = _model_and_data(args)
     result = _validate_numbers(model, data)
     if args.json:
-        print(json.dumps(result, indent=2))
+        print(json_text(result))
         return 0
     st = model.structure_
     print(f"model: {args.model} ({model.n_regions_} regions, {st.describe_orders()}, "
@@ -274,9 +274,13 @@ def _common_data_args(parser):
                         help="use only these rows (Python slice: 0:5000; write --rows=-1001: for a negative start)")
 
 
+# the registry's names, written out so that `hwpts --help` does not import the library (a test
+# checks that they match hwpts.identification.segmentation.SEGMENTATION_METHODS)
+SEGMENTATION_NAMES = ("alternating", "average", "clustering", "hyperplane", "kmeans", "threshold", "zscore")
+
+
 def register(subparsers):
     from hwpts.commands._args import non_negative_float, non_negative_int
-    from hwpts.identification.segmentation import SEGMENTATION_METHODS
 
     p = subparsers.add_parser(
         "identify", help="fit a PWARX model to a data file",
@@ -292,7 +296,7 @@ def register(subparsers):
                    help="input order, an int or one per input: 4,4 (default: chosen on the data, 1-4)")
     p.add_argument("--nk", default=None, metavar="N",
                    help="input delay, 0 uses u(k) (default: chosen on the data, 0-1; 1 when --na and --nb are given)")
-    p.add_argument("--segmentation", choices=["auto", *sorted(SEGMENTATION_METHODS)], default=None,
+    p.add_argument("--segmentation", choices=["auto", *SEGMENTATION_NAMES], default=None,
                    help="segmentation method (default auto: chosen on the data among threshold, clustering and "
                         "alternating; hyperplane when --hyperplane is given)")
     p.add_argument("--regions", default="auto", metavar="S",
