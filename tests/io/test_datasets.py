@@ -64,3 +64,26 @@ def test_nan_is_read_then_refused_by_the_dataset(tmp_path):
     cols = read_table(path)
     with pytest.raises(DataError, match="non-finite"):
         IODataset.from_columns(cols, ["u"], "y", time_name=None)
+
+
+@pytest.mark.parametrize("text", [
+    '"V1","V2",\n0.5,1.5,\n-2,3,\n',          # the official Silverbox file: quoted names, trailing comma
+    "V1;V2\r\n0.5;1.5\r\n-2;3\r\n",             # semicolons and CRLF
+    "\ufeffV1\tV2\n0.5\t1.5\n-2\t3\n",          # a byte-order mark and tabs
+])
+def test_csv_forms_read_as_published(tmp_path, text):
+    path = tmp_path / "d.csv"
+    path.write_text(text, encoding="utf-8")
+    cols = read_table(path)
+    assert list(cols) == ["V1", "V2"]
+    np.testing.assert_array_equal(cols["V1"], [0.5, -2.0])
+    np.testing.assert_array_equal(cols["V2"], [1.5, 3.0])
+
+
+def test_only_the_named_columns_are_parsed(tmp_path):
+    path = tmp_path / "d.csv"
+    path.write_text("date,u,y\n2026-11-22,1,2\n2026-11-23,3,4\n")
+    cols = read_table(path, ["u", "y"])
+    assert list(cols) == ["u", "y"]
+    with pytest.raises(DataError, match="line 2, column 'date': expected a number, got '2026-11-22'"):
+        read_table(path)

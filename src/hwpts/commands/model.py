@@ -38,7 +38,7 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
     from hwpts.dataset import IODataset
     from hwpts.io.datasets import read_table
 
-    columns = read_table(path)
+    columns = read_table(path, [*input_names, output_name, *([time_name] if time_name else ["time_s"])])
     if time_name is not None and time_name not in columns:
         raise DataError(f"{str(path)!r}: no time column {time_name!r}; available columns are {sorted(columns)}")
     missing = [c for c in [*input_names, output_name] if c not in columns]

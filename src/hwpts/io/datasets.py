@@ -20,8 +20,12 @@ from hwpts.io.atomic import atomic_path, write_text_atomic
 SUPPORTED_SUFFIXES = (".csv", ".parquet", ".mat")
 
 
-def read_table(path: str | os.PathLike) -> dict[str, np.ndarray]:
-    """Read a table of numeric columns from ``.csv``, ``.parquet`` or ``.mat``."""
+def read_table(path: str | os.PathLike, columns=None) -> dict[str, np.ndarray]:
+    """Read a table of numeric columns from ``.csv``, ``.parquet`` or ``.mat``.
+
+    ``columns``: the names the caller needs; a CSV's other columns may hold anything (text, dates)
+    and are not converted. Without it every column must be numeric.
+    """
     p = Path(path)
     if not p.exists():
         raise DataError(f"{str(p)!r}: no such file")
@@ -29,7 +33,7 @@ def read_table(path: str | os.PathLike) -> dict[str, np.ndarray]:
         raise DataError(f"{str(p)!r}: is a folder, expected a .csv, .parquet or .mat file")
     suffix = p.suffix.lower()
     if suffix == ".csv":
-        return read_csv(p)
+        return read_csv(p, columns)
     if suffix == ".parquet":
         return _read_parquet(p)
     if suffix == ".mat":
@@ -39,18 +43,75 @@ def read_table(path: str | os.PathLike) -> dict[str, np.ndarray]:
     )
 
 
-def read_csv(path: str | os.PathLike) -> dict[str, np.ndarray]:
-    """Read a CSV file with one header row of column names and numeric rows."""
+DELIMITERS = (",", ";", "\t")
+
+
+def _sniff(p: Path) -> str:
+    """The delimiter of the header line: the most frequent of comma, semicolon and tab."""
+    try:
+        with p.open("rb") as f:
+            head = f.read(65536)
+    except OSError as error:
+        raise DataError(f"{str(p)!r}: cannot read ({error.strerror or error})") from None
+    text = head.decode("utf-8-sig", errors="replace")
+    first = next((line for line in text.splitlines() if line.strip()), "")
+    counts = {d: first.count(d) for d in DELIMITERS}
+    best = max(counts, key=counts.get)
+    return best if counts[best] > 0 else ","
+
+
+def read_csv(path: str | os.PathLike, columns=None) -> dict[str, np.ndarray]:
+    """Read a CSV file with one header row of column names (pyarrow's reader).
+
+    The delimiter (comma, semicolon or tab) is detected from the header; a byte-order mark, CRLF
+    line ends, quoted names and trailing empty columns (a comma at the end of every row, as the
+    official Silverbox file) are accepted. Only the ``columns`` asked for (default: all) must be
+    numeric. A malformed file is diagnosed line by line (the line number in the message).
+    """
+    import pyarrow as pa
+    import pyarrow.csv as pacsv
+
     p = Path(path)
+    delimiter = _sniff(p)
+    try:
+        table = pacsv.read_csv(p, parse_options=pacsv.ParseOptions(delimiter=delimiter))
+    except (pa.ArrowInvalid, pa.ArrowTypeError, UnicodeDecodeError):
+        return _read_csv_python(p, delimiter, columns)  # raises the precise error
+    except OSError as error:
+        raise DataError(f"{str(p)!r}: cannot read ({error.strerror or error})") from None
+    names = [str(n).strip() for n in table.column_names]
+    # an unnamed column with no value (a trailing delimiter on every row) is not a column
+    keep = [i for i, n in enumerate(names) if n or table.column(i).null_count < table.num_rows]
+    if any(not names[i] for i in keep) or len({names[i] for i in keep}) != len(keep):
+        return _read_csv_python(p, delimiter, columns)  # empty or duplicate names: said precisely
+    if table.num_rows == 0:
+        raise DataError(f"{str(p)!r}: no data rows after the header")
+    wanted = [i for i in keep if columns is None or names[i] in set(columns)]
+    out = {}
+    for i in wanted:
+        name = names[i]
+        column = table.column(i)
+        if not (pa.types.is_floating(column.type) or pa.types.is_integer(column.type) or pa.types.is_null(column.type)):
+            return _read_csv_python(p, delimiter, columns)
+        out[name] = column.cast(pa.float64()).to_numpy(zero_copy_only=False)
+    return out
+
+
+def _read_csv_python(p: Path, delimiter: str = ",", columns=None) -> dict[str, np.ndarray]:
+    """The line-by-line reader: slow, but it names the line of every problem."""
     try:
         text = p.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError:
         raise DataError(f"{str(p)!r}: not a UTF-8 text file, expected CSV") from None
-    rows = list(csv.reader(io.StringIO(text)))
+    except OSError as error:
+        raise DataError(f"{str(p)!r}: cannot read ({error.strerror or error})") from None
+    rows = list(csv.reader(io.StringIO(text), delimiter=delimiter))
     rows = [r for r in rows if any(cell.strip() for cell in r)]
     if not rows:
         raise DataError(f"{str(p)!r}: empty file, expected a header row of column names")
     header = [h.strip() for h in rows[0]]
+    while header and not header[-1]:  # trailing empty columns (a comma at the end of every row)
+        header.pop()
     if len(set(header)) != len(header):
         dup = sorted({h for h in header if header.count(h) > 1})
         raise DataError(f"{str(p)!r}: duplicate column name(s) {dup}")
@@ -59,20 +120,24 @@ def read_csv(path: str | os.PathLike) -> dict[str, np.ndarray]:
     body = rows[1:]
     if not body:
         raise DataError(f"{str(p)!r}: no data rows after the header")
+    wanted = [j for j, h in enumerate(header) if columns is None or h in set(columns)]
     values = np.empty((len(body), len(header)))
     for i, row in enumerate(body, start=2):
+        while len(row) > len(header) and not row[-1].strip():
+            row = row[:-1]
         if len(row) != len(header):
             raise DataError(
                 f"{str(p)!r} line {i}: {len(row)} fields, expected {len(header)} (as in the header)"
             )
-        for j, cell in enumerate(row):
+        for j in wanted:
+            cell = row[j]
             try:
                 values[i - 2, j] = float(cell)
             except ValueError:
                 raise DataError(
                     f"{str(p)!r} line {i}, column {header[j]!r}: expected a number, got {cell.strip()!r}"
                 ) from None
-    return {name: values[:, j].copy() for j, name in enumerate(header)}
+    return {header[j]: values[:, j].copy() for j in wanted}
 
 
 def write_csv(path: str | os.PathLike, columns: Mapping[str, np.ndarray], fmt: str = "%.10g") -> None:
