@@ -1,7 +1,5 @@
 """``python -m hwpts`` runs the command-line interface."""
 
-import sys
+from hwpts.cli import entry
 
-from hwpts.cli import main
-
-sys.exit(main())
+entry()

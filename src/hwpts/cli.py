@@ -16,6 +16,7 @@ from collections.abc import Sequence
 
 from hwpts import __version__
 from hwpts.errors import HwptsError, UsageError
+from hwpts.io.atomic import INTERRUPTED as _INTERRUPTED  # set by SIGINT/SIGTERM (stdlib only: --help stays fast)
 
 EXIT_OK = 0
 EXIT_USAGE = 2
@@ -63,8 +64,24 @@ def _check_outputs(args) -> None:
                              f"the input; choose another output path")
 
 
-def _sigterm(signum, frame):  # pragma: no cover - exercised in a subprocess test
+
+def _interrupt(signum, frame):  # pragma: no cover - exercised in a subprocess test
+    _INTERRUPTED.set()
     raise KeyboardInterrupt
+
+
+def _quiet_interrupts(hook):
+    """An unraisable-exception hook that stays silent about the interrupt.
+
+    A signal that arrives inside a C callback (numba compiling a kernel, for example) raises
+    ``KeyboardInterrupt`` where Python can only print it as "Exception ignored ..." with a
+    traceback; the run then fails with a secondary error that :func:`main` reports as interrupted.
+    """
+    def quiet(unraisable):
+        if isinstance(unraisable.exc_value, KeyboardInterrupt) or _INTERRUPTED.is_set():
+            return
+        hook(unraisable)
+    return quiet
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -74,13 +91,40 @@ def main(argv: Sequence[str] | None = None) -> int:
     earlier outputs stay intact, exit status 130 and one line.
     """
     parser = build_parser()
-    previous = None
+    previous: dict = {}
+    hook = sys.unraisablehook
+    _INTERRUPTED.clear()
     if threading.current_thread() is threading.main_thread():
-        previous = signal.signal(signal.SIGTERM, _sigterm)
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            previous[sig] = signal.signal(sig, _interrupt)
+        sys.unraisablehook = _quiet_interrupts(hook)
+    try:
+        return _run(parser, argv)
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+        sys.unraisablehook = hook
+        _INTERRUPTED.clear()
+
+
+def _run(parser: ArgumentParser, argv: Sequence[str] | None) -> int:
+    """Parse and dispatch; every failure becomes one line and an exit status."""
     try:
         args = parser.parse_args(argv)
         _check_outputs(args)
-        return int(args.handler(args) or EXIT_OK)
+        status = int(args.handler(args) or EXIT_OK)
+    except BaseException as error:
+        if isinstance(error, KeyboardInterrupt) or (_INTERRUPTED.is_set() and isinstance(error, Exception)):
+            print("hwpts: interrupted", file=sys.stderr)
+            return 130
+        return _report(error)
+    return status
+
+
+def _report(error: BaseException) -> int:
+    """One line on stderr for a known failure; anything else is re-raised (a bug: keep its traceback)."""
+    try:
+        raise error
     except HwptsError as error:
         print(f"hwpts: error: {error}", file=sys.stderr)
         return EXIT_USAGE
@@ -102,13 +146,22 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"hwpts: error: numerical failure ({type(error).__name__}: {error}); check the data's scale "
               f"and the options (e.g. --ridge)", file=sys.stderr)
         return EXIT_USAGE
-    except KeyboardInterrupt:
-        print("hwpts: interrupted", file=sys.stderr)
-        return 130
-    finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+
+
+def entry() -> None:  # pragma: no cover - the console script, exercised in subprocess tests
+    """The ``hwpts`` console script: :func:`main` on ``sys.argv``, then exit with its status.
+
+    After an interrupt the process ends at once (``os._exit``, streams flushed): a signal that
+    landed inside a compiled library (LLVM compiling a numba kernel) can leave it in a state whose
+    teardown at interpreter exit crashes; every output and temporary file is already settled.
+    """
+    status = main()
+    if status == 130:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(130)
+    sys.exit(status)
 
 
 if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())
+    entry()

@@ -9,9 +9,21 @@ import contextlib
 import os
 import stat
 import tempfile
+import threading
 from pathlib import Path
 
 from hwpts.errors import DataError
+
+
+INTERRUPTED = threading.Event()
+"""Set by the command line's SIGINT/SIGTERM handler: no output is committed once it is set."""
+
+
+def commit_allowed() -> None:
+    """Raise ``KeyboardInterrupt`` if the run was interrupted (an interrupt swallowed by a library
+    callback must not let the run write its outputs after the user asked it to stop)."""
+    if INTERRUPTED.is_set():
+        raise KeyboardInterrupt
 
 
 def umask_mode(base: int = 0o666) -> int:
@@ -58,6 +70,7 @@ def atomic_path(path: str | os.PathLike, suffix: str | None = None):
         raise DataError(f"--out {str(target)!r}: cannot write there ({error.strerror or error})") from None
     try:
         yield Path(tmp)
+        commit_allowed()
         os.chmod(tmp, umask_mode())
         os.replace(tmp, target)
     except OSError as error:

@@ -11,7 +11,7 @@ import tempfile
 from pathlib import Path
 
 from hwpts.errors import DataError
-from hwpts.io.atomic import umask_mode
+from hwpts.io.atomic import commit_allowed, umask_mode
 
 
 def check_replaceable(path: str | os.PathLike, schema: str, marker: str = "summary.json") -> None:
@@ -74,6 +74,7 @@ def staged_folder(path: str | os.PathLike, schema: str):
         raise DataError(f"--out {str(out)!r}: cannot write there ({error.strerror or error})") from None
     try:
         yield stage
+        commit_allowed()
         (stage / PID_FILE).unlink()
         os.chmod(stage, umask_mode(0o777))
     except BaseException:
