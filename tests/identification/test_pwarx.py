@@ -195,3 +195,34 @@ def test_refinement_that_empties_a_region_leaves_one_model():
         m = PWARX(0, [1, 1, 1], [0, 0, 0], n_regions=2, segmentation="alternating", random_state=0,
                   partition_columns=["u3(k)"]).fit(x, y)
     assert m.n_regions_ == 1 and m.partition_.n_regions == 1
+
+
+def test_k_step_prediction_is_the_free_run_from_each_start():
+    from hwpts.identification.simulation import simulate_pwarx
+    from hwpts.identification.synthetic import make_system
+
+    d = make_system(5, rng=0, n=500)
+    model = PWARX(2, 2, 1, n_regions=3, segmentation="threshold", random_state=0).fit(d.inputs, d.output)
+    u, y = d.inputs, d.output
+    m = model.structure_.max_lag
+    np.testing.assert_array_equal(model.predict(u, y, horizon=1), model.predict(u, y))
+    free = model.simulate(u, y).output
+    np.testing.assert_array_equal(model.predict(u, y, horizon=len(y)), free)
+    # just below the free-run shortcut, the step-by-step recursion gives the free run too
+    np.testing.assert_allclose(model.predict(u, y, horizon=len(y) - m - 1), free, rtol=0, atol=1e-12)
+    for k in (2, 5, 40):
+        q = model.predict(u, y, horizon=k)
+        for t in (m, m + 3, 120, 499):
+            s = max(t - k + 1, m)  # the run starts at s from the measured outputs before it
+            run = simulate_pwarx(model.structure_, model.partition_, model.theta_, u[s - m:t + 1], y[s - m:t + 1])
+            assert abs(run.output[-1] - q[t]) < 1e-12
+
+
+@pytest.mark.parametrize("bad", [0, -2, 1.5, True, "3"])
+def test_k_step_horizon_is_checked(bad):
+    from hwpts.identification.synthetic import make_system
+
+    d = make_system(5, rng=0, n=300)
+    model = PWARX(2, 2, 1, n_regions=1, segmentation="average").fit(d.inputs, d.output)
+    with pytest.raises(ParameterError, match="horizon must be an int >= 1"):
+        model.predict(d.inputs, d.output, horizon=bad)

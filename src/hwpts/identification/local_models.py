@@ -19,7 +19,7 @@ import numpy as np
 
 from hwpts.errors import IdentificationError, ParameterError
 
-__all__ = ["RegionWarning", "LocalModels", "fit_local_models", "MODEL_KINDS"]
+__all__ = ["RegionWarning", "LocalModels", "fit_local_models", "parameter_covariance", "MODEL_KINDS"]
 
 MODEL_KINDS = ("affine", "constant", "zero")
 ILL_CONDITIONED = 1e10
@@ -44,12 +44,22 @@ class LocalModels:
         Training samples per region.
     condition : ndarray
         Condition number of each region's (column-scaled) least-squares matrix (nan if not fitted).
+    covariance : ndarray, shape (n_regions, n_features + 1, n_features + 1)
+        Covariance of each region's parameters from its least squares,
+        ``sigma_i^2 (Phi_i' Phi_i)^-1`` with ``sigma_i^2 = RSS_i / (n_i - p)`` (the standard
+        errors of MATLAB's ``getcov``); zero for a zero mode, ``nan`` where ``n_i <= p``.
     """
 
     theta: np.ndarray
     kinds: tuple
     n_samples: np.ndarray
     condition: np.ndarray
+    covariance: np.ndarray | None = None
+
+    @property
+    def std(self) -> np.ndarray:
+        """Standard errors of ``theta``, shape (n_regions, n_features + 1)."""
+        return np.sqrt(np.clip(np.diagonal(self.covariance, axis1=1, axis2=2), 0.0, None))
 
     def predict(self, X: np.ndarray, regions: np.ndarray) -> np.ndarray:
         """y_k = phi_k' theta_{sigma(k)} (eq. 5)."""
@@ -94,6 +104,33 @@ def solve_region(X: np.ndarray, y: np.ndarray, constant: bool, ridge: float = 0.
     return theta, cond
 
 
+def parameter_covariance(X: np.ndarray, y: np.ndarray, theta: np.ndarray, constant: bool) -> np.ndarray:
+    """Covariance ``sigma^2 (Phi' Phi)^-1`` of one region's least-squares parameters (eq. 17).
+
+    ``sigma^2 = RSS / (n - p)``, the residual variance with ``p`` parameters; the matrix is over
+    ``[x' 1]`` (offset last; its row and column are zero without a constant term). ``nan`` when the
+    region has no more samples than parameters.
+    """
+    n, nf = X.shape
+    cov = np.full((nf + 1, nf + 1), np.nan)
+    Phi = np.hstack([X, np.ones((n, 1))]) if constant else X
+    p = Phi.shape[1]
+    if n <= p:
+        return cov
+    r = y - X @ theta[:nf] - theta[nf]
+    sigma2 = float(r @ r) / (n - p)
+    scale = np.sqrt(np.mean(Phi**2, axis=0))
+    scale[scale == 0] = 1.0
+    A = Phi / scale
+    inv = np.linalg.pinv(A.T @ A) / np.outer(scale, scale)
+    if constant:
+        cov[:] = sigma2 * inv
+    else:
+        cov[:] = 0.0
+        cov[:nf, :nf] = sigma2 * inv
+    return cov
+
+
 def fit_local_models(X: np.ndarray, y: np.ndarray, labels: np.ndarray, n_regions: int,
                      constant: bool = True, kinds=None, ridge: float = 0.0, warn: bool = True,
                      trim: float | None = None) -> LocalModels:
@@ -121,10 +158,12 @@ def fit_local_models(X: np.ndarray, y: np.ndarray, labels: np.ndarray, n_regions
     theta = np.zeros((n_regions, nf + 1))
     counts = np.bincount(labels, minlength=n_regions)[:n_regions]
     cond = np.full(n_regions, np.nan)
+    cov = np.full((n_regions, nf + 1, nf + 1), np.nan)
     n_par = nf + int(constant)
     for i, kind in enumerate(kinds):
         mask = labels == i
         if kind == "zero":
+            cov[i] = 0.0
             continue
         if counts[i] == 0:
             raise IdentificationError(
@@ -133,6 +172,8 @@ def fit_local_models(X: np.ndarray, y: np.ndarray, labels: np.ndarray, n_regions
             )
         if kind == "constant":
             theta[i, -1] = float(np.mean(y[mask]))
+            cov[i] = 0.0
+            cov[i, -1, -1] = float(np.var(y[mask], ddof=1)) / counts[i] if counts[i] > 1 else np.nan
             continue
         if warn and counts[i] < n_par:
             warnings.warn(
@@ -140,16 +181,19 @@ def fit_local_models(X: np.ndarray, y: np.ndarray, labels: np.ndarray, n_regions
                 f"the minimum-norm least-squares solution", RegionWarning, stacklevel=2,
             )
         theta[i], cond[i] = solve_region(X[mask], y[mask], constant, ridge)
+        Xi, yi = X[mask], y[mask]
         if trim is not None and counts[i] > 2 * n_par:
-            r = y[mask] - X[mask] @ theta[i, :-1] - theta[i, -1]
+            r = yi - Xi @ theta[i, :-1] - theta[i, -1]
             sd = 1.4826 * np.median(np.abs(r - np.median(r)))
             keep = np.abs(r) <= trim * sd
             if sd > 0 and n_par < keep.sum() < keep.size:
-                theta[i], cond[i] = solve_region(X[mask][keep], y[mask][keep], constant, ridge)
+                Xi, yi = Xi[keep], yi[keep]
+                theta[i], cond[i] = solve_region(Xi, yi, constant, ridge)
+        cov[i] = parameter_covariance(Xi, yi, theta[i], constant)
         if warn and counts[i] >= n_par and cond[i] > ILL_CONDITIONED:
             warnings.warn(
                 f"region {i + 1}: least squares is ill-conditioned (condition number {cond[i]:.3g}); "
                 f"its inputs may not be exciting enough, consider a ridge penalty",
                 RegionWarning, stacklevel=2,
             )
-    return LocalModels(theta, kinds, counts.astype(np.int64), cond)
+    return LocalModels(theta, kinds, counts.astype(np.int64), cond, cov)

@@ -35,7 +35,7 @@ from hwpts.identification.partition import (
 )
 from hwpts.identification.regressors import RegressorStructure, validate_signals
 from hwpts.identification.segmentation import make_segmenter
-from hwpts.identification.simulation import SimulationResult, one_step_pwarx, simulate_pwarx
+from hwpts.identification.simulation import SimulationResult, k_step_pwarx, one_step_pwarx, simulate_pwarx
 from hwpts.identification.statespace import mode_state_space
 
 __all__ = ["PWARX", "FreeRunDivergedWarning"]
@@ -118,6 +118,11 @@ class PWARX(BaseEstimator):
     output_range_ : (float, float)
     input_ranges_ : ndarray, shape (n_inputs, 2)
     segmentation_info_ : dict
+    parameter_cov_ : ndarray, shape (n_regions_, n_features + 1, n_features + 1)
+        Covariance of each mode's parameters from its local least squares (eq. 17),
+        ``sigma_i^2 (Phi_i' Phi_i)^-1`` with the region's residual variance; ``nan`` where unknown
+        (a region with no more samples than parameters). With ``polish`` or ``ridge`` it is the
+        least-squares covariance, an approximation.
     """
 
     def __init__(self, output_order=1, input_order=1, input_delay=1, n_regions=2,
@@ -263,6 +268,7 @@ class PWARX(BaseEstimator):
         self.region_counts_ = local.n_samples
         self.training_labels_ = labels
         self.condition_ = local.condition
+        self.parameter_cov_ = local.covariance
         self.input_names_ = names
         self.output_name_ = structure.output_name
         self.n_features_in_ = n_inputs
@@ -312,14 +318,24 @@ class PWARX(BaseEstimator):
             raise DataError(f"expected {self.n_features_in_} input columns, got {u.shape[1]}")
         return u, yy
 
-    def predict(self, X, y=None) -> np.ndarray:
-        """One-step-ahead prediction from measured past outputs (eq. 5 with measured ``x_k``).
+    def predict(self, X, y=None, horizon: int = 1) -> np.ndarray:
+        """``horizon``-step-ahead prediction from measured past outputs (eq. 5).
 
-        Returns an array of length n; its first ``max_lag`` entries are the measured outputs.
+        ``horizon=1`` (default): one step ahead, eq. 5 with the measured regressor ``x_k``.
+        ``horizon=k``: ``yhat(t | t-k)``, the free run over ``k`` steps from the measured outputs
+        up to ``t-k`` (see :func:`hwpts.identification.simulation.k_step_pwarx`); a horizon of
+        ``n - max_lag`` or more is the free run :meth:`simulate`. Returns an array of length n;
+        its first ``max_lag`` entries are the measured outputs (``nan`` where a run diverged).
         """
         u, yy = self._check_inputs(X, y)
         self.structure_.check_length(yy.shape[0])
-        yhat, _ = one_step_pwarx(self.structure_, self.partition_, self.theta_, u, yy)
+        if isinstance(horizon, bool) or not isinstance(horizon, (int, np.integer)) or horizon < 1:
+            raise ParameterError(f"horizon must be an int >= 1 (samples), got {horizon!r}")
+        if horizon == 1:
+            yhat, _ = one_step_pwarx(self.structure_, self.partition_, self.theta_, u, yy)
+            return yhat
+        center, half = self.divergence_band()
+        yhat, _ = k_step_pwarx(self.structure_, self.partition_, self.theta_, u, yy, int(horizon), center, half)
         return yhat
 
     def predict_regions(self, X, y=None) -> np.ndarray:
@@ -364,6 +380,15 @@ class PWARX(BaseEstimator):
             warnings.warn(sim.reason, FreeRunDivergedWarning, stacklevel=2)
         return sim.score(yy)
 
+    @property
+    def parameter_std_(self) -> np.ndarray:
+        """Standard errors of ``theta_`` (square roots of the diagonal of ``parameter_cov_``)."""
+        check_is_fitted(self, "theta_")
+        cov = getattr(self, "parameter_cov_", None)
+        if cov is None:
+            return np.full(self.theta_.shape, np.nan)
+        return np.sqrt(np.clip(np.diagonal(cov, axis1=1, axis2=2), 0.0, None))
+
     # ------------------------------------------------------------------ analysis
     def state_space(self) -> list:
         """State-space form (eq. 7) of every mode, with its poles (:class:`ModeStateSpace`)."""
@@ -382,9 +407,12 @@ class PWARX(BaseEstimator):
         """JSON-ready description: orders, regions, per-mode sample counts and pole moduli."""
         check_is_fitted(self, "theta_")
         regions = []
+        std = self.parameter_std_
         for i, ss in enumerate(self.state_space()):
             regions.append({
                 "region": i + 1, "model": self.region_models_[i],
+                "theta": [float(f"{v:.8g}") for v in self.theta_[i]],
+                "theta_std": [float(f"{v:.4g}") if np.isfinite(v) else None for v in std[i]],
                 "n_train_samples": int(self.region_counts_[i]),
                 "max_pole_modulus": round(ss.max_pole_modulus, 6), "stable": ss.stable,
             })
@@ -423,6 +451,7 @@ class PWARX(BaseEstimator):
         est.region_counts_ = np.zeros(partition.n_regions, dtype=np.int64)
         est.training_labels_ = np.zeros(0, dtype=np.int64)
         est.condition_ = np.full(partition.n_regions, np.nan)
+        est.parameter_cov_ = np.full((partition.n_regions, theta.shape[1], theta.shape[1]), np.nan)
         est.input_names_ = structure.input_names
         est.output_name_ = structure.output_name
         est.n_features_in_ = structure.n_inputs

@@ -137,3 +137,51 @@ def one_step_pwarx(structure, partition, theta, inputs, output) -> tuple[np.ndar
     yhat = np.concatenate([y[:m], pred])
     reg = np.concatenate([np.full(m, -1, dtype=np.int64), regions])
     return yhat, reg
+
+
+def k_step_pwarx(structure, partition, theta, inputs, output, horizon: int,
+                 center: float = 0.0, bound: float = np.inf) -> tuple[np.ndarray, np.ndarray]:
+    """k-step-ahead prediction ``yhat(t | t-k)``: (yhat, regions), the first max_lag measured/-1.
+
+    ``yhat(t | t-k)`` is the free run (eqs. 5, 8, 10) started at ``s = t-k+1`` from the measured
+    outputs before ``s`` and the measured inputs; where ``s`` would fall inside the initial
+    conditions the run starts after them. ``horizon=1`` is the one-step prediction; a horizon of
+    at least ``n - max_lag`` is the free run from the first ``max_lag`` samples.
+
+    Computed for every ``t`` at once, step by step: with ``Q_j(t)`` the ``j``-step prediction,
+    the regressor of ``Q_j(t)`` holds ``Q_{j-i}(t-i)`` for output lags ``i < j`` (the same run)
+    and measured outputs for ``i >= j``; cost ``O(k n)``. A prediction outside the band
+    ``|y - center| <= bound`` is ``nan`` (the run diverged).
+    """
+    y = np.asarray(output, dtype=float)
+    n = y.shape[0]
+    m = structure.max_lag
+    if horizon <= 1:
+        return one_step_pwarx(structure, partition, theta, inputs, y)
+    if horizon >= n - m:  # every start falls at the initial conditions: the free run
+        sim = simulate_pwarx(structure, partition, theta, inputs, y, center, bound)
+        return sim.output, sim.regions
+    X, _ = structure.build(inputs, y)
+    na = structure.na
+    th = np.asarray(theta, dtype=float)
+    t = np.arange(m, n)
+    history: list[np.ndarray] = []  # history[i-1] = Q_{j-i} over all times (measured before m)
+    regions = None
+    for j in range(1, horizon + 1):
+        Xj = X
+        if na and history:
+            Xj = X.copy()
+            for i in range(1, min(na, j - 1) + 1):
+                Xj[:, i - 1] = history[i - 1][t - i]
+        regions = partition.predict(Xj)
+        sel = th[regions]
+        pred = np.einsum("ij,ij->i", Xj, sel[:, :-1]) + sel[:, -1]
+        pred[~(np.abs(pred - center) <= bound)] = np.nan
+        q = np.concatenate([y[:m], pred])
+        if na:
+            history.insert(0, q)
+            del history[na:]
+        if not na:  # no output in the regressor: every horizon is the one-step prediction
+            break
+    reg = np.concatenate([np.full(m, -1, dtype=np.int64), regions])
+    return q, reg

@@ -57,11 +57,15 @@ def model_to_dict(model) -> dict:
 
     st = model.structure_
     regions = []
+    std = model.parameter_std_
+    cov = getattr(model, "parameter_cov_", None)
     for i, ss in enumerate(model.state_space()):
         regions.append({
             "region": i + 1,
             "model": model.region_models_[i],
             "theta": [float(v) for v in model.theta_[i]],
+            "theta_std": _jsonable(std[i]),
+            "theta_covariance": None if cov is None else _jsonable(cov[i]),
             "n_train_samples": int(model.region_counts_[i]),
             "max_pole_modulus": float(ss.max_pole_modulus),
             "stable": bool(ss.stable),
@@ -137,6 +141,22 @@ def _numbers(value, shape_desc: str, where: str) -> np.ndarray:
     return arr
 
 
+def _covariance(reg: dict, i: int, nf: int) -> np.ndarray:
+    """A region's parameter covariance (optional in the file: older files have none -> nan;
+    ``null`` entries, written for unknown values, are nan)."""
+    value = reg.get("theta_covariance")
+    if value is None:
+        return np.full((nf + 1, nf + 1), np.nan)
+    if not isinstance(value, list) or len(value) != nf + 1 or not all(
+            isinstance(row, list) and len(row) == nf + 1 for row in value):
+        raise DataError(f"regions[{i}].theta_covariance must be a {nf + 1} x {nf + 1} matrix")
+    try:
+        arr = np.array([[np.nan if v is None else v for v in row] for row in value], dtype=float)
+    except (TypeError, ValueError):
+        raise DataError(f"regions[{i}].theta_covariance must hold numbers") from None
+    return arr
+
+
 def model_from_dict(doc: dict):
     """Validate a model document and build the estimator (see module doc for what is checked)."""
     from hwpts.identification.partition import RegionPartition
@@ -172,7 +192,7 @@ def model_from_dict(doc: dict):
     regions = _require(doc, "regions", list, "the model")
     if not regions:
         raise DataError("the model has no region")
-    theta, kinds = [], []
+    theta, kinds, covs = [], [], []
     for i, reg in enumerate(regions):
         th = _numbers(_require(reg, "theta", list, f"regions[{i}]"), f"{nf + 1} numbers", f"regions[{i}].theta")
         if th.shape != (nf + 1,):
@@ -182,6 +202,7 @@ def model_from_dict(doc: dict):
             raise DataError(f"regions[{i}].model is {kind!r}; expected affine, constant or zero")
         theta.append(th)
         kinds.append(kind)
+        covs.append(_covariance(reg, i, nf))
     part_doc = _require(doc, "partition", dict, "the model")
     polys = _require(part_doc, "polyhedra", list, "partition")
     if len(polys) != len(regions):
@@ -208,6 +229,7 @@ def model_from_dict(doc: dict):
     seg = doc.get("segmentation") or {}
     model = PWARX.from_parts(structure, partition, np.array(theta), kinds, out_range, in_ranges,
                              segmentation_info=seg if isinstance(seg, dict) else {})
+    model.parameter_cov_ = np.array(covs)
     model.region_counts_ = np.array([int(r.get("n_train_samples", 0)) for r in regions], dtype=np.int64)
     if isinstance(seg, dict) and isinstance(seg.get("method"), str):
         model.segmentation = seg["method"]
