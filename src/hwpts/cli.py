@@ -51,18 +51,21 @@ def build_parser() -> ArgumentParser:
 INPUT_ARGS = ("data", "model", "inputs")  # arguments that name files a command reads
 
 
+OUTPUT_ARGS = ("out", "plot")  # arguments that name files a command writes
+
+
 def _check_outputs(args) -> None:
     """An output that is one of the command's inputs is refused (it would destroy the input)."""
-    out = getattr(args, "out", None)
-    if out is None or str(out) == "-":
-        return
-    target = os.path.realpath(out)
-    for name in INPUT_ARGS:
-        source = getattr(args, name, None)
-        if source is not None and os.path.realpath(source) == target:
-            raise UsageError(f"--out {str(out)!r} is the {name} file {str(source)!r}: writing it would destroy "
-                             f"the input; choose another output path")
-
+    for flag in OUTPUT_ARGS:
+        out = getattr(args, flag, None)
+        if out is None or str(out) == "-":
+            continue
+        target = os.path.realpath(out)
+        for name in INPUT_ARGS:
+            source = getattr(args, name, None)
+            if source is not None and os.path.realpath(source) == target:
+                raise UsageError(f"--{flag} {str(out)!r} is the {name} file {str(source)!r}: writing it would "
+                                 f"destroy the input; choose another output path")
 
 
 def _interrupt(signum, frame):  # pragma: no cover - exercised in a subprocess test

@@ -226,3 +226,18 @@ def test_k_step_horizon_is_checked(bad):
     model = PWARX(2, 2, 1, n_regions=1, segmentation="average").fit(d.inputs, d.output)
     with pytest.raises(ParameterError, match="horizon must be an int >= 1"):
         model.predict(d.inputs, d.output, horizon=bad)
+
+
+def test_dataframes_are_matched_by_column_name():
+    pd = pytest.importorskip("pandas")  # a test dependency (hwpts[test])
+    d = make_system(5, rng=0, n=600)
+    frame = pd.DataFrame({"valve": d.inputs[:, 0], "pump": d.inputs[:, 1]})
+    y = pd.Series(d.output, name="speed")
+    model = PWARX(2, 2, 1, n_regions=2, segmentation="threshold").fit(frame, y.to_frame())  # y as (n, 1)
+    assert model.input_names_ == ("valve", "pump") and model.output_name_ == "speed"
+    swapped = frame[["pump", "valve"]]
+    np.testing.assert_array_equal(model.predict(swapped, y), model.predict(frame, y))
+    np.testing.assert_array_equal(model.simulate(swapped, y).output, model.simulate(frame, y).output)
+    np.testing.assert_array_equal(model.predict(frame.to_numpy(), d.output), model.predict(frame, y))
+    with pytest.raises(DataError, match=r"no input column\(s\) \['pump'\]"):
+        model.predict(frame.rename(columns={"pump": "flow"}), y)

@@ -39,6 +39,14 @@ def non_negative_int(text: str) -> int:
     return value
 
 
+def positive_int(text: str) -> int:
+    """An integer >= 1."""
+    value = non_negative_int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}")
+    return value
+
+
 def grid(text: str) -> tuple[float, float, int]:
     """START:STOP:N, an increasing grid of N >= 1 points (START == STOP only when N == 1)."""
     parts = text.split(":")

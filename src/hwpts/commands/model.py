@@ -35,6 +35,8 @@ def _rows(text: str | None):
 
 
 def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
+    """The named columns of a data file as an :class:`IODataset`; its ``sample_time_s`` attribute
+    is the sample period from the time column, or None when the file has none (time = row index)."""
     from hwpts.dataset import IODataset
     from hwpts.io.datasets import read_table
 
@@ -50,11 +52,80 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
     if n == 0:
         raise DataError(f"{str(path)!r}: no rows selected (--rows {rows})")
     tname = time_name if time_name is not None else ("time_s" if "time_s" in cols else None)
+    timed = tname is not None
     if tname is None:
         # time = sample index of the file (keeps the original numbering under --rows)
         cols["__index__"] = np.arange(len(columns[output_name]), dtype=float)[sl]
         tname = "__index__"
-    return IODataset.from_columns(cols, list(input_names), output_name, time_name=tname)
+    data = IODataset.from_columns(cols, list(input_names), output_name, time_name=tname)
+    dt = _sample_time(data, path, tname) if timed else None
+    return data, dt
+
+
+def _sample_time(data, path, tname) -> float | None:
+    """The data's sample period [s] from its time column; a non-uniform time axis is refused."""
+    if data.n_samples < 2:
+        return None
+    steps = np.diff(data.time)
+    dt = float(np.median(steps))
+    worst = float(np.max(np.abs(steps - dt)))
+    if worst > 0.01 * dt:
+        row = int(np.argmax(np.abs(steps - dt))) + 1
+        raise DataError(f"{str(path)!r}: the time column {tname!r} is not uniformly sampled (step {dt:.6g} s, "
+                        f"but {steps[row - 1]:.6g} s at row {row}); PWARX models need a constant sample time")
+    return dt
+
+
+SAMPLE_TIME_TOLERANCE = 0.01  # relative difference of sample times treated as equal
+
+
+def _resampled(data, dt, model_dt):
+    """``data`` linearly interpolated onto the model's sample time (``--resample``)."""
+    from hwpts.dataset import IODataset
+
+    t = np.arange(data.time[0], data.time[-1] + 0.5 * model_dt, model_dt)
+    t = t[t <= data.time[-1] + 1e-12 * abs(data.time[-1])]
+    inputs = np.column_stack([np.interp(t, data.time, data.inputs[:, j]) for j in range(data.inputs.shape[1])])
+    return IODataset(t, inputs, np.interp(t, data.time, data.output), data.input_names, data.output_name)
+
+
+def _check_sample_time(model, data, dt, path, resample: bool):
+    """Refuse data sampled at another rate than the model's (or resample them when asked)."""
+    model_dt = getattr(model, "sample_time_", None)
+    if model_dt is None or dt is None:
+        if resample:
+            raise ParameterError("--resample needs a time column in DATA and a model that knows its sample time")
+        return data
+    if abs(dt - model_dt) <= SAMPLE_TIME_TOLERANCE * model_dt:
+        return data
+    if resample:
+        return _resampled(data, dt, model_dt)
+    raise DataError(f"{str(path)!r}: sample time {dt:.6g} s ({1 / dt:.6g} Hz) differs from the model's "
+                    f"{model_dt:.6g} s ({1 / model_dt:.6g} Hz): its lags would mean other delays; resample the "
+                    f"data (--resample interpolates linearly) or refit")
+
+
+# units recognised from a column name's suffix (the plant's and the paper's naming: speed_rpm, ...)
+UNIT_SUFFIXES = {"_rpm": "r/min", "_v": "V", "_bar": "bar", "_s": "s", "_nm": "N m", "_mm": "mm",
+                 "_m": "m", "_hz": "Hz", "_w": "W", "_kw": "kW", "_pct": "%", "_lpm": "L/min", "_deg": "deg"}
+
+
+def _units(names, given) -> dict:
+    """Units of the named signals: ``--unit NAME=UNIT`` first, else from the name's suffix."""
+    units = {}
+    for name in names:
+        for suffix, unit in UNIT_SUFFIXES.items():
+            if name.lower().endswith(suffix):
+                units[name] = unit
+                break
+    for text in given or ():
+        name, sep, unit = str(text).partition("=")
+        if not sep or not name.strip() or not unit.strip():
+            raise ParameterError(f"--unit expects NAME=UNIT (e.g. y=mm), got {text!r}")
+        if name.strip() not in names:
+            raise ParameterError(f"--unit {text!r}: {name.strip()!r} is not one of the signals {list(names)}")
+        units[name.strip()] = unit.strip()
+    return units
 
 
 def _fit_summary(model, data, path, out, elapsed, search=None):
@@ -66,6 +137,8 @@ def _fit_summary(model, data, path, out, elapsed, search=None):
     y = data.output[m:]
     summary = {"model": str(out), "data": str(path), "n_samples": data.n_samples}
     summary.update(model.summary())
+    summary["sample_time_s"] = getattr(model, "sample_time_", None)
+    summary["units"] = dict(getattr(model, "units_", {}) or {})
     summary["train_fit_percent"] = None if sim.diverged else round(fit_percent(y, sim.output[m:]), 3)
     summary["train_one_step_fit_percent"] = round(fit_percent(y, one[m:]), 3)
     summary["train_rmse"] = None if sim.diverged else rmse(y, sim.output[m:])
@@ -114,7 +187,8 @@ def cmd_identify(args) -> int:
     from hwpts.identification.selection import DEFAULT_METHODS
     from hwpts.io.models import save_model
 
-    data = _load_dataset(args.data, args.input, args.output, args.time, args.rows)
+    data, dt = _load_dataset(args.data, args.input, args.output, args.time, args.rows)
+    units = _units([*args.input, args.output], args.unit)
     fixed, searched = _orders_to_search(args)
     if not searched:
         structure = RegressorStructure.create(fixed["output_order"], fixed["input_order"], fixed["input_delay"],
@@ -173,10 +247,12 @@ def cmd_identify(args) -> int:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         if search is not None:
-            search.fit(data.inputs, data.output, input_names=args.input, output_name=args.output)
+            search.fit(data.inputs, data.output, input_names=args.input, output_name=args.output,
+                       sample_time=dt, units=units)
             model = search.best_estimator_
         else:
-            model.fit(data.inputs, data.output, input_names=args.input, output_name=args.output)
+            model.fit(data.inputs, data.output, input_names=args.input, output_name=args.output,
+                      sample_time=dt, units=units)
     elapsed = time.perf_counter() - t0
     summary = _fit_summary(model, data, args.data, args.out, elapsed, search)
     notes = sorted({str(w.message) for w in caught if issubclass(w.category, UserWarning)})
@@ -215,17 +291,27 @@ def _validate_numbers(model, data):
 
 
 def _model_and_data(args):
+    """The model and the data mapped onto its signals (by name, or by --input/--output), at its rate."""
     from hwpts.io.models import load_model
 
     model = load_model(args.model)
-    data = _load_dataset(args.data, list(model.structure_.input_names), model.structure_.output_name,
-                         args.time, args.rows)
+    st = model.structure_
+    inputs = list(args.input) if args.input else list(st.input_names)
+    if len(inputs) != st.n_inputs:
+        raise ParameterError(f"--input was given {len(inputs)} time(s); the model has {st.n_inputs} inputs "
+                             f"{list(st.input_names)} (map each, in order)")
+    output = args.output or st.output_name
+    data, dt = _load_dataset(args.data, inputs, output, args.time, args.rows)
+    data = _check_sample_time(model, data, dt, args.data, args.resample)
     return model, data
 
 
 def cmd_validate(args) -> int:
     model, data = _model_and_data(args)
     result = _validate_numbers(model, data)
+    if args.plot is not None:
+        _write_validation_plot(model, data, result, args)
+        result["plot"] = str(args.plot)
     if args.json:
         print(json_text(result))
         return 0
@@ -239,7 +325,24 @@ def cmd_validate(args) -> int:
     else:
         print(f"free-run fit: {result['fit_percent']:.2f} %  (rmse {result['rmse']:.6g})")
     print(f"one-step fit: {result['one_step_fit_percent']:.2f} %  (rmse {result['one_step_rmse']:.6g})")
+    if args.plot is not None:
+        print(f"wrote {args.plot}")
     return 0
+
+
+def _write_validation_plot(model, data, result, args):
+    from hwpts.io.atomic import write_bytes_atomic
+    from hwpts.reporting.analysis import validation_figure
+
+    sim = model.simulate(data.inputs, data.output)
+    units = getattr(model, "units_", {}) or {}
+    timed = getattr(model, "sample_time_", None) is not None and args.time != "__index__"
+    png = validation_figure(
+        data.time, data.output, sim.output, sim.regions, n_initial=model.structure_.max_lag,
+        output_name=model.structure_.output_name, unit=units.get(model.structure_.output_name),
+        fit_percent=result["fit_percent"], time_unit="s" if timed else None,
+        title=f"{args.model} on {args.data}")
+    write_bytes_atomic(args.plot, png)
 
 
 def cmd_predict(args) -> int:
@@ -248,14 +351,27 @@ def cmd_predict(args) -> int:
     model, data = _model_and_data(args)
     model.structure_.check_length(data.n_samples)
     name = data.output_name
-    if args.mode == "simulate":
+    if args.horizon is not None:
+        if args.mode_given:
+            raise ParameterError("--horizon K is a k-step prediction: do not combine it with --mode")
+        yhat = model.predict(data.inputs, data.output, horizon=args.horizon)
+        regions = model.predict_regions(data.inputs, data.output) if args.horizon == 1 else None
+        if regions is None:
+            from hwpts.identification.simulation import k_step_pwarx
+
+            center, half = model.divergence_band()
+            _, regions = k_step_pwarx(model.structure_, model.partition_, model.theta_, data.inputs, data.output,
+                                      args.horizon, center, half)
+        mode = f"{args.horizon}-step"
+    elif args.mode == "simulate":
         sim = model.simulate(data.inputs, data.output)
         if sim.diverged:
             raise SimulationError(f"{sim.reason}; no file written (try --mode one-step)")
-        yhat, regions = sim.output, sim.regions
+        yhat, regions, mode = sim.output, sim.regions, "simulate"
     else:
         yhat = model.predict(data.inputs, data.output)
         regions = model.predict_regions(data.inputs, data.output)
+        mode = "one-step"
     columns = {"time_s": data.time}
     for j, nm in enumerate(data.input_names):
         columns[nm] = data.inputs[:, j]
@@ -263,13 +379,14 @@ def cmd_predict(args) -> int:
     columns[f"{name}_predicted"] = yhat
     columns["region"] = regions + 1  # 1-based; 0 marks the initial conditions
     write_csv(args.out, columns)
-    print(f"wrote {args.out} ({data.n_samples} rows, mode {args.mode}; region 0 = initial conditions)")
+    print(f"wrote {args.out} ({data.n_samples} rows, mode {mode}; region 0 = initial conditions)")
     return 0
 
 
 def _common_data_args(parser):
     parser.add_argument("--time", metavar="COL", default=None,
-                        help="time column [s] (default: time_s if present, else the sample index)")
+                        help="time column [s] (default: time_s if present, else the sample index); its step "
+                             "is the sample time")
     parser.add_argument("--rows", metavar="START:STOP", default=None,
                         help="use only these rows (Python slice: 0:5000; write --rows=-1001: for a negative start)")
 
@@ -279,8 +396,33 @@ def _common_data_args(parser):
 SEGMENTATION_NAMES = ("alternating", "average", "clustering", "hyperplane", "kmeans", "threshold", "zscore")
 
 
+def _mapping_args(parser):
+    parser.add_argument("--input", metavar="COL", action="append", default=None,
+                        help="data column for the model's inputs, in order (repeat; default: the model's names)")
+    parser.add_argument("--output", metavar="COL", default=None,
+                        help="data column for the model's output (default: the model's name)")
+    parser.add_argument("--resample", action="store_true",
+                        help="interpolate data sampled at another rate onto the model's sample time "
+                             "(default: refuse them)")
+
+
+def _png_path(text: str):
+    import argparse
+
+    if not str(text).lower().endswith(".png"):
+        raise argparse.ArgumentTypeError(f"expected a .png file name, got {text!r}")
+    return text
+
+
 def register(subparsers):
-    from hwpts.commands._args import non_negative_float, non_negative_int
+    import argparse
+
+    from hwpts.commands._args import non_negative_float, non_negative_int, positive_int
+
+    class ModeAction(argparse.Action):
+        def __call__(self, parser, namespace, values, option_string=None):
+            setattr(namespace, self.dest, values)
+            namespace.mode_given = True
 
     p = subparsers.add_parser(
         "identify", help="fit a PWARX model to a data file",
@@ -316,6 +458,9 @@ def register(subparsers):
                    help="ridge penalty of the local least squares (relative to the regressors' scale; default 0)")
     p.add_argument("--polish", action="store_true", help="refine parameters on the free-run simulation error")
     p.add_argument("--seed", type=non_negative_int, default=0, metavar="N", help="random seed (default 0)")
+    p.add_argument("--unit", action="append", default=[], metavar="NAME=UNIT",
+                   help="unit of a signal for plots and exports, e.g. y=mm (repeat; default: from the column "
+                        "name's suffix: _rpm r/min, _v V, _bar bar, _mm mm, ...)")
     p.add_argument("--out", required=True, metavar="MODEL.json", help="model file to write")
     _common_data_args(p)
     p.set_defaults(handler=cmd_identify)
@@ -325,6 +470,9 @@ def register(subparsers):
     v.add_argument("model", metavar="MODEL.json")
     v.add_argument("data", metavar="DATA")
     v.add_argument("--json", action="store_true", help="print one JSON object")
+    v.add_argument("--plot", metavar="FILE.png", type=_png_path, default=None,
+                   help="write a figure: measured and simulated output, residual, active region")
+    _mapping_args(v)
     _common_data_args(v)
     v.set_defaults(handler=cmd_validate)
 
@@ -333,6 +481,11 @@ def register(subparsers):
     r.add_argument("model", metavar="MODEL.json")
     r.add_argument("data", metavar="DATA")
     r.add_argument("--out", required=True, metavar="FILE.csv")
-    r.add_argument("--mode", choices=["simulate", "one-step"], default="simulate")
+    r.add_argument("--mode", choices=["simulate", "one-step"], default="simulate", action=ModeAction,
+                   help="free run (default) or one-step-ahead prediction")
+    r.add_argument("--horizon", type=positive_int, default=None, metavar="K",
+                   help="K-step-ahead prediction y(t|t-K): 1 is one-step, K >= the data length is the free run")
+    r.set_defaults(mode_given=False)
+    _mapping_args(r)
     _common_data_args(r)
     r.set_defaults(handler=cmd_predict)

@@ -15,11 +15,14 @@ python-control is an optional dependency (``pip install hwpts[control]``).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
+from scipy.stats import norm
 
-from hwpts.errors import ParameterError
+from hwpts.errors import DataError, ParameterError
 
-__all__ = ["to_control", "mode_initial_state"]
+__all__ = ["to_control", "mode_initial_state", "ResidualAnalysis", "residual_analysis", "correlation"]
 
 
 def _control():
@@ -60,3 +63,134 @@ def mode_initial_state(structure, inputs, output, k: int) -> np.ndarray:
         m = nk + nb - 1 if nb > 0 else 0
         x += [u[k - i, j] for i in range(1, m + 1)]
     return np.asarray(x, dtype=float)
+
+
+def correlation(a: np.ndarray, b: np.ndarray, lags: int) -> np.ndarray:
+    """Normalised cross-correlation ``r_ab(tau) = sum_t a(t) b(t-tau) / (N sd_a sd_b)``, tau = 0..lags.
+
+    Both signals have their mean removed; ``correlation(e, e, L)[0] = 1``.
+    """
+    a = np.asarray(a, dtype=float) - np.mean(a)
+    b = np.asarray(b, dtype=float) - np.mean(b)
+    n = a.shape[0]
+    denom = n * np.std(a) * np.std(b)
+    if denom == 0:
+        return np.full(lags + 1, np.nan)
+    return np.array([a[tau:] @ b[:n - tau] for tau in range(lags + 1)]) / denom
+
+
+@dataclass(frozen=True)
+class ResidualAnalysis:
+    """Whiteness and independence tests of the one-step residuals (MATLAB's ``resid``).
+
+    A correct model leaves residuals ``e(t) = y(t) - yhat(t|t-1)`` that are white (autocorrelation
+    zero at every lag > 0) and uncorrelated with past inputs (cross-correlation zero at lags >= 0).
+    Under that hypothesis each normalised correlation is about normal with standard deviation
+    ``1/sqrt(N)``: the band ``+-z/sqrt(N)`` holds it with probability ``confidence`` (99 %:
+    ``z = 2.576``), so about 1 % of the lags fall outside by chance.
+
+    Attributes
+    ----------
+    residuals : ndarray
+        One-step residuals after the initial conditions (length ``N``), in the output's unit.
+    lags : int
+    confidence : float
+    band : float
+        Half-width ``z/sqrt(N)`` of the confidence band.
+    autocorrelation : ndarray, shape (lags + 1,)
+        ``r_ee(tau)``, tau = 0..lags (``r_ee(0) = 1``; lag 0 is not tested).
+    cross_correlation : dict of str -> ndarray, shape (lags + 1,)
+        ``r_eu(tau)`` per input: residual at ``t`` against the input at ``t - tau``, tau = 0..lags.
+    """
+
+    residuals: np.ndarray
+    lags: int
+    confidence: float
+    band: float
+    autocorrelation: np.ndarray
+    cross_correlation: dict
+
+    @property
+    def n_samples(self) -> int:
+        return int(self.residuals.shape[0])
+
+    def outside_share(self) -> dict:
+        """Share of tested lags outside the band: autocorrelation (lags 1..L), each input (0..L), all."""
+        auto = np.abs(self.autocorrelation[1:]) > self.band
+        cross = {k: np.abs(v) > self.band for k, v in self.cross_correlation.items()}
+        every = np.concatenate([auto, *cross.values()])
+        return {"autocorrelation": float(np.mean(auto)),
+                "cross_correlation": {k: float(np.mean(v)) for k, v in cross.items()},
+                "all": float(np.mean(every))}
+
+    def to_dict(self) -> dict:
+        """JSON-ready: the correlations, the band and the shares of lags outside it."""
+        share = self.outside_share()
+        rms = float(np.sqrt(np.mean(self.residuals ** 2)))
+        return {
+            "n_residuals": self.n_samples, "residual_rms": rms, "lags": self.lags,
+            "confidence": self.confidence, "band": self.band,
+            "autocorrelation": [float(v) for v in self.autocorrelation],
+            "cross_correlation": {k: [float(x) for x in v] for k, v in self.cross_correlation.items()},
+            "outside_share": share,
+            "white": share["autocorrelation"] <= 0.05,
+            "independent_of_inputs": all(v <= 0.05 for v in share["cross_correlation"].values()),
+        }
+
+
+def residual_analysis(model, inputs, output, lags: int = 25, confidence: float = 0.99) -> ResidualAnalysis:
+    """Residual tests of a fitted ``PWARX`` on measured data (see :class:`ResidualAnalysis`).
+
+    ``lags``: the largest lag tested (samples); ``confidence``: of the band (0.5 < c < 1).
+    """
+    if isinstance(lags, bool) or not isinstance(lags, (int, np.integer)) or lags < 1:
+        raise ParameterError(f"lags must be an int >= 1, got {lags!r}")
+    if not 0.5 < float(confidence) < 1:
+        raise ParameterError(f"confidence must lie in (0.5, 1), got {confidence!r}")
+    yhat = model.predict(inputs, output)
+    m = model.structure_.max_lag
+    y = np.asarray(output, dtype=float).ravel()
+    e = y[m:] - yhat[m:]
+    if e.shape[0] <= lags + 1:
+        raise DataError(f"{e.shape[0]} residuals are too few for {lags} lags; use fewer lags or more data")
+    u = np.asarray(inputs, dtype=float).reshape(y.shape[0], -1)[m:]
+    band = float(norm.ppf(0.5 + float(confidence) / 2) / np.sqrt(e.shape[0]))
+    cross = {name: correlation(e, u[:, j], lags) for j, name in enumerate(model.structure_.input_names)}
+    return ResidualAnalysis(e, int(lags), float(confidence), band, correlation(e, e, lags), cross)
+
+
+def state_space_export(model) -> dict:
+    """Every mode's affine state space (eq. 7) and the partition, as plain arrays for export.
+
+    Returns a dict: ``sample_time_s`` (or None), ``inputs``, ``output``, ``units``,
+    ``state_names``, ``regressor_names`` and per mode ``A``, ``B``, ``C``, ``D``, ``e`` (state
+    offset), ``c`` (output offset), ``poles``; ``H``, ``g`` per region: the region is
+    ``{x : H x + g <= 0}`` over the regressor vector named ``regressor_names`` (eq. 9).
+    """
+    st = model.structure_
+    modes = []
+    for i, ss in enumerate(model.state_space()):
+        modes.append({"region": i + 1, "model": model.region_models_[i], "A": np.atleast_2d(ss.A),
+                      "B": np.asarray(ss.B).reshape(ss.A.shape[0], st.n_inputs),
+                      "C": np.asarray(ss.C).reshape(1, ss.A.shape[0]), "D": np.asarray(ss.D).reshape(1, st.n_inputs),
+                      "e": np.asarray(ss.e).reshape(ss.A.shape[0]), "c": float(ss.c),
+                      "poles": np.asarray(ss.poles)})
+    part = model.partition_
+    return {
+        "sample_time_s": getattr(model, "sample_time_", None),
+        "inputs": list(st.input_names), "output": st.output_name,
+        "units": dict(getattr(model, "units_", {}) or {}),
+        "state_names": _state_names(st),
+        "regressor_names": list(st.feature_names),
+        "modes": modes,
+        "H": [np.asarray(h) for h in part.H], "g": [np.asarray(g) for g in part.g],
+    }
+
+
+def _state_names(structure) -> list[str]:
+    """Names of the state of eq. 7: past outputs, then each input's past samples."""
+    names = [f"{structure.output_name}(k-{i})" for i in range(1, structure.na + 1)]
+    for name, nb, nk in zip(structure.input_names, structure.nb, structure.nk):
+        m = nk + nb - 1 if nb > 0 else 0
+        names += [f"{name}(k-{i})" for i in range(1, m + 1)]
+    return names

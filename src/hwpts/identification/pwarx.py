@@ -156,7 +156,19 @@ class PWARX(BaseEstimator):
             return X.inputs, X.output, X.input_names, X.output_name
         if y is None:
             raise ParameterError("fit needs the measured output y (or an IODataset)")
-        u, yy = validate_signals(X, y)
+        frame_names = _column_names(X)
+        if frame_names is not None:
+            if names is not None and tuple(names) != frame_names:
+                raise ParameterError(f"input_names {list(names)} differ from the DataFrame's columns "
+                                     f"{list(frame_names)}; select the columns instead")
+            names = frame_names
+        if output_name is None:  # a named Series, or a one-column DataFrame
+            y_columns = _column_names(y)
+            if isinstance(getattr(y, "name", None), str):
+                output_name = y.name
+            elif y_columns is not None and len(y_columns) == 1:
+                output_name = y_columns[0]
+        u, yy = validate_signals(_as_array(X), _output_vector(y))
         return u, yy, names, output_name
 
     def _segmenter(self):
@@ -181,13 +193,22 @@ class PWARX(BaseEstimator):
             )
         return make_segmenter(self.segmentation, **params)
 
-    def fit(self, X, y=None, input_names=None, output_name=None, breaks=None):
+    def fit(self, X, y=None, input_names=None, output_name=None, breaks=None, sample_time=None, units=None):
         """Identify the model from inputs ``X`` (n, n_inputs) and output ``y`` (n,), or an IODataset.
 
+        ``X`` may be a pandas DataFrame: its column names become the input names, and later
+        predictions select the columns by name (in any order). ``y`` may have shape (n, 1).
         ``breaks``: sample positions where the record restarts (several experiments joined, or the
         two sides of a held-out block); regressor rows whose lags span a break are dropped.
-        Returns ``self``.
+        ``sample_time``: the sample period [s] of the data (taken from an IODataset's time when not
+        given); kept in the model so that data at another rate are refused. ``units``: optional
+        ``{signal name: unit}`` kept for plots and exports. Returns ``self``.
         """
+        if sample_time is None and isinstance(X, IODataset) and X.n_samples > 1:
+            sample_time = X.sample_time
+        if sample_time is not None and (isinstance(sample_time, bool) or not np.isfinite(sample_time)
+                                        or sample_time <= 0):
+            raise ParameterError(f"sample_time must be a positive number of seconds or None, got {sample_time!r}")
         u, yy, names, oname = self._signals(X, y, input_names, output_name)
         n_inputs = u.shape[1]
         names = tuple(names) if names is not None else tuple(f"u{j + 1}" for j in range(n_inputs))
@@ -275,6 +296,8 @@ class PWARX(BaseEstimator):
         self.output_range_ = (float(yy.min()), float(yy.max()))
         self.input_ranges_ = np.column_stack([u.min(axis=0), u.max(axis=0)])
         self.segmentation_info_ = {"method": segmenter.name, **seg.info}
+        self.sample_time_ = None if sample_time is None else float(sample_time)
+        self.units_ = {str(k): str(v) for k, v in dict(units or {}).items()}
         if sparse_columns is not None:
             self.segmentation_info_["partition_columns"] = [structure.feature_names[c] for c in sparse_columns]
         if self.polish:
@@ -302,7 +325,12 @@ class PWARX(BaseEstimator):
         if isinstance(X, IODataset):
             if y is not None:
                 raise ParameterError("pass either an IODataset or (inputs, output), not both")
-            X, y = X.inputs, X.output
+            X, y = _select_columns(X.inputs, X.input_names, self.input_names_), X.output
+        else:
+            frame_names = _column_names(X)
+            X = _as_array(X)
+            if frame_names is not None:
+                X = _select_columns(X, frame_names, self.input_names_)
         if y is None and need_y:
             raise ParameterError(
                 f"the measured output is needed (the first {self.structure_.max_lag} samples are "
@@ -311,7 +339,7 @@ class PWARX(BaseEstimator):
         u = np.asarray(X, dtype=float)
         if u.ndim == 1:
             u = u[:, None]
-        yy = None if y is None else np.asarray(y, dtype=float).ravel()
+        yy = None if y is None else _output_vector(y)
         if yy is not None:
             u, yy = validate_signals(u, yy, self.n_features_in_)
         elif u.shape[1] != self.n_features_in_:
@@ -397,11 +425,12 @@ class PWARX(BaseEstimator):
 
     def to_control(self, dt=None) -> list:
         """One python-control ``StateSpace`` per mode (the offset as the last input, held at 1);
-        see :func:`hwpts.identification.analysis.to_control` (needs ``hwpts[control]``)."""
+        see :func:`hwpts.identification.analysis.to_control` (needs ``hwpts[control]``).
+        ``dt`` defaults to the model's sample time when it is known."""
         from hwpts.identification.analysis import to_control
 
         check_is_fitted(self, "theta_")
-        return to_control(self, dt)
+        return to_control(self, dt if dt is not None else getattr(self, "sample_time_", None))
 
     def summary(self) -> dict:
         """JSON-ready description: orders, regions, per-mode sample counts and pole moduli."""
@@ -459,4 +488,41 @@ class PWARX(BaseEstimator):
         est.input_ranges_ = (np.asarray(input_ranges, dtype=float) if input_ranges is not None
                              else np.full((structure.n_inputs, 2), np.nan))
         est.segmentation_info_ = dict(segmentation_info or {})
+        est.sample_time_ = None
+        est.units_ = {}
         return est
+
+
+def _column_names(X) -> tuple[str, ...] | None:
+    """The column names of a DataFrame-like ``X`` (pandas, polars: a ``columns`` attribute), else None."""
+    columns = getattr(X, "columns", None)
+    if columns is None or isinstance(X, np.ndarray):
+        return None
+    return tuple(str(c) for c in columns)
+
+
+def _as_array(X):
+    """A DataFrame-like as a numpy array (its ``to_numpy``); anything else unchanged."""
+    to_numpy = getattr(X, "to_numpy", None)
+    return to_numpy() if callable(to_numpy) and not isinstance(X, np.ndarray) else X
+
+
+def _output_vector(y) -> np.ndarray:
+    """The output as a 1-D array: shape (n,) or (n, 1) (a one-column DataFrame or Series too)."""
+    arr = np.asarray(_as_array(y))
+    if arr.ndim == 2 and arr.shape[1] == 1:
+        arr = arr[:, 0]
+    return arr
+
+
+def _select_columns(u, names, wanted) -> np.ndarray:
+    """The columns of ``u`` (named ``names``) in the order ``wanted``: data are matched by name."""
+    names = tuple(names)
+    if names == tuple(wanted):
+        return u
+    missing = [w for w in wanted if w not in names]
+    if missing:
+        raise DataError(f"the data have no input column(s) {missing} (the model's inputs are {list(wanted)}; "
+                        f"the data's columns are {list(names)})")
+    u = np.asarray(u)
+    return u[:, [names.index(w) for w in wanted]]

@@ -21,7 +21,8 @@ import numpy as np
 from hwpts.errors import DataError, HwptsError
 
 SCHEMA = "hwpts.pwarx/1"
-CHECKED_SECTIONS = ("structure", "regions", "partition", "training")
+CHECKED_SECTIONS = ("structure", "regions", "partition", "training", "signals")
+REQUIRED_SECTIONS = CHECKED_SECTIONS[:4]  # "signals" (sample time, units) came later: optional
 
 __all__ = ["SCHEMA", "model_to_dict", "model_from_dict", "save_model", "load_model", "dumps_model"]
 
@@ -44,9 +45,9 @@ def _jsonable(value):
     return value
 
 
-def checksum(doc: dict) -> str:
+def checksum(doc: dict, sections=CHECKED_SECTIONS) -> str:
     """SHA-256 of the canonical JSON of the numeric sections (sorted keys, no spaces)."""
-    payload = {k: doc.get(k) for k in CHECKED_SECTIONS}
+    payload = {k: doc.get(k) for k in sections}
     text = json.dumps(payload, sort_keys=True, separators=(",", ":"), allow_nan=False)
     return hashlib.sha256(text.encode("utf-8")).hexdigest()
 
@@ -80,6 +81,10 @@ def model_to_dict(model) -> dict:
             "output_range": [float(v) for v in model.output_range_],
             "input_ranges": [[float(a), float(b)] for a, b in np.asarray(model.input_ranges_)],
             "n_samples": int(np.sum(model.region_counts_)) + st.max_lag,
+        },
+        "signals": {
+            "sample_time_s": getattr(model, "sample_time_", None),
+            "units": dict(getattr(model, "units_", {}) or {}),
         },
         "segmentation": _jsonable({"method": model.summary()["segmentation"], **model.segmentation_info_}),
     }
@@ -141,6 +146,22 @@ def _numbers(value, shape_desc: str, where: str) -> np.ndarray:
     return arr
 
 
+def _signals_section(section, structure) -> tuple[float | None, dict]:
+    """The sample time [s] (or None) and the units from the optional ``signals`` section."""
+    if section is None:
+        return None, {}
+    if not isinstance(section, dict):
+        raise DataError("signals must be an object")
+    dt = section.get("sample_time_s")
+    if dt is not None and (isinstance(dt, bool) or not isinstance(dt, (int, float)) or not math.isfinite(dt)
+                           or dt <= 0):
+        raise DataError(f"signals.sample_time_s must be a positive number or null, got {dt!r}")
+    units = section.get("units") or {}
+    if not isinstance(units, dict) or not all(isinstance(k, str) and isinstance(v, str) for k, v in units.items()):
+        raise DataError("signals.units must map signal names to unit strings")
+    return (None if dt is None else float(dt)), dict(units)
+
+
 def _covariance(reg: dict, i: int, nf: int) -> np.ndarray:
     """A region's parameter covariance (optional in the file: older files have none -> nan;
     ``null`` entries, written for unknown values, are nan)."""
@@ -168,12 +189,13 @@ def model_from_dict(doc: dict):
     schema = doc.get("schema")
     if schema != SCHEMA:
         raise DataError(f"schema {schema!r} is not {SCHEMA!r}; this is not an hwpts PWARX model file")
-    for key in (*CHECKED_SECTIONS, "checksum"):
+    for key in (*REQUIRED_SECTIONS, "checksum"):
         _require(doc, key, None, "the model")
     cs = _require(doc, "checksum", dict, "the model")
     value = _require(cs, "value", str, "checksum")
+    sections = CHECKED_SECTIONS if "signals" in doc else REQUIRED_SECTIONS
     try:
-        expected = checksum(doc)
+        expected = checksum(doc, sections)
     except ValueError:
         raise DataError("the model holds a non-finite number") from None
     if value != expected:
@@ -230,6 +252,7 @@ def model_from_dict(doc: dict):
     model = PWARX.from_parts(structure, partition, np.array(theta), kinds, out_range, in_ranges,
                              segmentation_info=seg if isinstance(seg, dict) else {})
     model.parameter_cov_ = np.array(covs)
+    model.sample_time_, model.units_ = _signals_section(doc.get("signals"), structure)
     model.region_counts_ = np.array([int(r.get("n_train_samples", 0)) for r in regions], dtype=np.int64)
     if isinstance(seg, dict) and isinstance(seg.get("method"), str):
         model.segmentation = seg["method"]

@@ -3,7 +3,7 @@
 The switching of many real systems depends on one signal crossing a level: a position where a
 head touches a surface, a pressure where a valve opens, a level where a tank overflows. Such a
 PWARX model is a *threshold* ARX model (Tong's SETAR/TARX, Tong 1990; Hansen 2000): with the
-threshold variable ``x_c`` (a regressor column, default ``y(k-1)``) and ordered thresholds
+threshold variable ``x_c`` (a regressor column; by default the best one) and ordered thresholds
 ``t_1 < ... < t_{s-1}``, region ``i`` is ``{x : t_{i-1} < x_c <= t_i}`` (a polyhedron, eq. 9).
 
 The thresholds are estimated by conditional least squares, *exactly*: sorting the rows by ``x_c``
@@ -128,8 +128,9 @@ class ThresholdSegmenter(Segmenter):
     Parameters
     ----------
     column : str or None
-        Threshold variable: a regressor name (``"y(k-1)"``, ``"u1(k-2)"``) or an input/output name;
-        ``None`` tries every regressor column and keeps the best.
+        Threshold variable: a regressor name (``"y(k-1)"``, ``"u1(k-2)"``) or an input/output name
+        (the output's name means its first lag); ``None`` (default) tries every regressor column
+        and keeps the best.
     n_grid : int
         Candidate cuts on large data (more than 400 rows): this many quantiles of the column.
     min_share : float
@@ -139,7 +140,7 @@ class ThresholdSegmenter(Segmenter):
     name = "threshold"
     uses_n_regions = True
 
-    def __init__(self, *, column: str | None = "y(k-1)", n_grid: int = 200, min_share: float = 0.03):
+    def __init__(self, *, column: str | None = None, n_grid: int = 200, min_share: float = 0.03):
         self.column = column
         self.n_grid = n_grid
         self.min_share = min_share

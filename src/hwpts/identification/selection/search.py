@@ -287,8 +287,18 @@ class PWARXSearch(BaseEstimator):
         return -np.inf if v is None else v
 
     # ------------------------------------------------------------------ fit
-    def fit(self, X, y=None, input_names=None, output_name=None):
-        """Search, then refit the winner on all of ``(X, y)`` (or an IODataset). Returns ``self``."""
+    def fit(self, X, y=None, input_names=None, output_name=None, sample_time=None, units=None):
+        """Search, then refit the winner on all of ``(X, y)`` (or an IODataset). Returns ``self``.
+
+        ``sample_time`` [s] and ``units`` are kept in the chosen model as :meth:`PWARX.fit` does.
+        """
+        from hwpts.dataset import IODataset
+
+        if sample_time is None and isinstance(X, IODataset) and X.n_samples > 1:
+            sample_time = X.sample_time
+        if sample_time is not None and (isinstance(sample_time, bool) or not np.isfinite(sample_time)
+                                        or sample_time <= 0):
+            raise ParameterError(f"sample_time must be a positive number of seconds or None, got {sample_time!r}")
         base = self._base()
         u, yy, names, oname = base._signals(X, y, input_names, output_name)
         self._names = (names, oname)
@@ -318,6 +328,8 @@ class PWARXSearch(BaseEstimator):
         self.cv_results_ = table
         self._rank(table)
         self._choose_and_refit(base, table, u, yy, names, oname, splits)
+        self.best_estimator_.sample_time_ = None if sample_time is None else float(sample_time)
+        self.best_estimator_.units_ = {str(k): str(v) for k, v in dict(units or {}).items()}
         return self
 
     @staticmethod

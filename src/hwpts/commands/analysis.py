@@ -1,0 +1,100 @@
+"""``hwpts residuals | export``: residual tests of a model on data, and its state space exported."""
+
+from __future__ import annotations
+
+from hwpts.commands._args import json_text
+from hwpts.errors import ParameterError
+
+
+def cmd_residuals(args) -> int:
+    from hwpts.commands.model import _model_and_data
+    from hwpts.identification.analysis import residual_analysis
+
+    model, data = _model_and_data(args)
+    model.structure_.check_length(data.n_samples)
+    analysis = residual_analysis(model, data.inputs, data.output, lags=args.lags, confidence=args.confidence)
+    result = analysis.to_dict()
+    if args.plot is not None:
+        from hwpts.io.atomic import write_bytes_atomic
+        from hwpts.reporting.analysis import residual_figure
+
+        units = getattr(model, "units_", {}) or {}
+        name = model.structure_.output_name
+        write_bytes_atomic(args.plot, residual_figure(analysis, output_name=name, unit=units.get(name),
+                                                      title=f"{args.model} on {args.data}"))
+        result["plot"] = str(args.plot)
+    if args.json:
+        print(json_text(result))
+        return 0
+    share = result["outside_share"]
+    conf = f"{100 * result['confidence']:g} %"
+    print(f"residuals: {result['n_residuals']} one-step residuals of {model.structure_.output_name!r}, "
+          f"rms {result['residual_rms']:.6g}")
+    print(f"whiteness: {100 * share['autocorrelation']:.1f} % of lags 1..{args.lags} outside the {conf} band "
+          f"(+-{result['band']:.4g}) -> {'white' if result['white'] else 'NOT white'}")
+    for name, value in share["cross_correlation"].items():
+        print(f"input {name}: {100 * value:.1f} % of lags 0..{args.lags} outside the band -> "
+              f"{'uncorrelated' if value <= 0.05 else 'CORRELATED'}")
+    if args.plot is not None:
+        print(f"wrote {args.plot}")
+    return 0
+
+
+def cmd_export(args) -> int:
+    from hwpts import __version__
+    from hwpts.identification.analysis import state_space_export
+    from hwpts.io.export import EXPORT_FORMATS, write_export
+    from hwpts.io.models import load_model
+
+    suffix = EXPORT_FORMATS[args.format]
+    if not str(args.out).lower().endswith(suffix):
+        raise ParameterError(f"--out {str(args.out)!r}: --format {args.format} writes a {suffix} file; "
+                             f"name it ...{suffix}")
+    model = load_model(args.model)
+    doc = state_space_export(model)
+    write_export(args.out, args.format, doc, f"hwpts {__version__}", str(args.model))
+    n = doc["modes"][0]["A"].shape[0]
+    dt = doc["sample_time_s"]
+    print(f"wrote {args.out} ({args.format}: {len(doc['modes'])} modes of {n} states, "
+          f"{len(doc['inputs'])} inputs + offset, sample time {'unknown' if dt is None else f'{dt:g} s'})")
+    return 0
+
+
+def register(subparsers):
+    import argparse
+
+    from hwpts.commands._args import finite_float, positive_int
+    from hwpts.commands.model import _common_data_args, _mapping_args, _png_path
+
+    def confidence(text):
+        value = finite_float(text)
+        if not 0.5 < value < 1:
+            raise argparse.ArgumentTypeError(f"expected a probability in (0.5, 1), got {text!r}")
+        return value
+
+    r = subparsers.add_parser(
+        "residuals", help="whiteness and input-correlation tests of a model's one-step residuals",
+        description="Autocorrelation of the one-step residuals of MODEL on DATA and their cross-correlation "
+                    "with each input, with a confidence band (MATLAB's resid). A correct model leaves white "
+                    "residuals, uncorrelated with past inputs: about 1 %% of lags outside the 99 %% band.")
+    r.add_argument("model", metavar="MODEL.json")
+    r.add_argument("data", metavar="DATA")
+    r.add_argument("--lags", type=positive_int, default=25, metavar="L", help="largest lag tested [samples] (default 25)")
+    r.add_argument("--confidence", type=confidence, default=0.99, metavar="P",
+                   help="probability of the confidence band (default 0.99)")
+    r.add_argument("--plot", metavar="FILE.png", type=_png_path, default=None,
+                   help="write the correlations and the band as a figure")
+    r.add_argument("--json", action="store_true", help="print one JSON object")
+    _mapping_args(r)
+    _common_data_args(r)
+    r.set_defaults(handler=cmd_residuals)
+
+    e = subparsers.add_parser(
+        "export", help="export a model's per-mode state space (python-control, MATLAB, JSON)",
+        description="Each mode as the affine state space of the paper's eq. 7 with its region (eq. 9): "
+                    "--format control writes a Python module building python-control systems (MODES), "
+                    "matlab a .mat file (A, B, C, D, e, c, H, g, Ts), json a JSON document.")
+    e.add_argument("model", metavar="MODEL.json")
+    e.add_argument("--format", choices=["control", "matlab", "json"], required=True)
+    e.add_argument("--out", required=True, metavar="FILE", help="file to write: .py, .mat or .json by format")
+    e.set_defaults(handler=cmd_export)

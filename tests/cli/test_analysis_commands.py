@@ -1,0 +1,163 @@
+"""``hwpts validate --plot``, ``residuals``, ``predict --horizon``, ``export`` and the sample time
+kept in the model (issues 10 and 12)."""
+
+import json
+import runpy
+
+import numpy as np
+import pytest
+
+from hwpts.cli import main
+from hwpts.io.datasets import write_csv
+from hwpts.io.models import load_model
+
+
+def _second_order(seed=0, n=3000, dt=0.01):
+    """Two modes switching on u1(k-1), second-order dynamics, white equation noise (ARX structure)."""
+    rng = np.random.default_rng(seed)
+    u = rng.uniform(-1, 1, (n, 2))
+    y = np.zeros(n)
+    e = 0.05 * rng.standard_normal(n)
+    for k in range(2, n):
+        if u[k - 1, 0] >= 0:
+            y[k] = 1.5 * y[k - 1] - 0.7 * y[k - 2] + u[k - 1, 0] + 0.3 * u[k - 1, 1] + 0.1 + e[k]
+        else:
+            y[k] = 1.2 * y[k - 1] - 0.5 * y[k - 2] - 0.5 * u[k - 1, 0] + 0.8 * u[k - 1, 1] - 0.1 + e[k]
+    return np.arange(n) * dt, u, y
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    d = tmp_path_factory.mktemp("analysis")
+    t, u, y = _second_order()
+    write_csv(d / "data.csv", {"time_s": t, "valve_v": u[:, 0], "u2": u[:, 1], "y_mm": y})
+    common = ["--input", "valve_v", "--input", "u2", "--output", "y_mm", "--nb", "1",
+              "--segmentation", "hyperplane", "--hyperplane", "1,0@valve_v(k-1)"]
+    assert main(["identify", str(d / "data.csv"), *common, "--na", "2", "--out", str(d / "good.json")]) == 0
+    assert main(["identify", str(d / "data.csv"), *common, "--na", "1", "--out", str(d / "wrong.json")]) == 0
+    return d
+
+
+def _png_ok(path, min_size=(400, 300)):
+    import matplotlib.image as mpimg
+
+    img = mpimg.imread(path)
+    assert img.shape[1] >= min_size[0] and img.shape[0] >= min_size[1]
+    assert float(np.std(img[..., :3])) > 0.05  # not blank
+
+
+def test_validate_plot_writes_a_figure(files, capsys):
+    out = files / "v.png"
+    assert main(["validate", str(files / "good.json"), str(files / "data.csv"), "--plot", str(out)]) == 0
+    assert "wrote" in capsys.readouterr().out
+    _png_ok(out)
+
+
+def test_residuals_tell_a_correct_model_from_a_wrong_one(files, capsys):
+    capsys.readouterr()
+    assert main(["residuals", str(files / "good.json"), str(files / "data.csv"), "--json",
+                 "--plot", str(files / "r.png")]) == 0
+    good = json.loads(capsys.readouterr().out)
+    assert main(["residuals", str(files / "wrong.json"), str(files / "data.csv"), "--json"]) == 0
+    wrong = json.loads(capsys.readouterr().out)
+    assert good["outside_share"]["all"] < 0.05 and good["white"]
+    assert wrong["outside_share"]["all"] > 0.20 and not wrong["white"]
+    assert good["lags"] == 25 and len(good["autocorrelation"]) == 26
+    assert set(good["cross_correlation"]) == {"valve_v", "u2"}
+    _png_ok(files / "r.png")
+
+
+def test_predict_horizon_one_is_one_step_and_n_is_the_free_run(files, tmp_path):
+    data, model = str(files / "data.csv"), str(files / "good.json")
+
+    def predicted(*extra):
+        out = tmp_path / "p.csv"
+        assert main(["predict", model, data, "--out", str(out), *extra]) == 0
+        return np.genfromtxt(out, delimiter=",", names=True)["y_mm_predicted"]
+
+    np.testing.assert_array_equal(predicted("--horizon", "1"), predicted("--mode", "one-step"))
+    np.testing.assert_array_equal(predicted("--horizon", "3000"), predicted("--mode", "simulate"))
+    five = predicted("--horizon", "5")
+    assert not np.array_equal(five, predicted("--horizon", "1"))
+
+
+def test_predict_refuses_horizon_with_mode(files, tmp_path, capsys):
+    out = tmp_path / "p.csv"
+    assert main(["predict", str(files / "good.json"), str(files / "data.csv"), "--out", str(out),
+                 "--horizon", "4", "--mode", "one-step"]) == 2
+    assert "--horizon" in capsys.readouterr().err and not out.exists()
+
+
+def test_a_model_refuses_data_at_another_sample_time(files, tmp_path, capsys):
+    model = load_model(files / "good.json")
+    assert model.sample_time_ == pytest.approx(0.01) and model.units_ == {"valve_v": "V", "y_mm": "mm"}
+    t, u, y = _second_order()
+    fast = tmp_path / "fast.csv"
+    write_csv(fast, {"time_s": t / 10, "valve_v": u[:, 0], "u2": u[:, 1], "y_mm": y})
+    capsys.readouterr()
+    assert main(["validate", str(files / "good.json"), str(fast)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "sample time 0.001 s (1000 Hz) differs from the model's 0.01 s (100 Hz)" in err[0]
+    assert main(["validate", str(files / "good.json"), str(fast), "--resample", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["n_samples"] == 300
+
+
+def test_columns_are_matched_by_name_and_can_be_mapped(files, tmp_path, capsys):
+    t, u, y = _second_order()
+    shuffled = tmp_path / "shuffled.csv"
+    write_csv(shuffled, {"y_mm": y, "u2": u[:, 1], "time_s": t, "valve_v": u[:, 0]})
+    renamed = tmp_path / "renamed.csv"
+    write_csv(renamed, {"time_s": t, "a": u[:, 0], "b": u[:, 1], "out": y})
+    results = []
+    for path, extra in ((files / "data.csv", []), (shuffled, []),
+                        (renamed, ["--input", "a", "--input", "b", "--output", "out"])):
+        assert main(["validate", str(files / "good.json"), str(path), "--json", *extra]) == 0
+        results.append(json.loads(capsys.readouterr().out)["fit_percent"])
+    assert results[0] == results[1] == results[2]
+    assert main(["validate", str(files / "good.json"), str(renamed), "--input", "a"]) == 2
+    assert "--input was given 1 time(s); the model has 2 inputs" in capsys.readouterr().err
+
+
+def test_export_control_matlab_json(files, tmp_path, capsys):
+    control = pytest.importorskip("control")
+    from scipy.io import loadmat
+
+    model = load_model(files / "good.json")
+    reference = model.to_control()
+    py = tmp_path / "modes.py"
+    assert main(["export", str(files / "good.json"), "--format", "control", "--out", str(py)]) == 0
+    ns = runpy.run_path(str(py))
+    assert len(ns["MODES"]) == len(reference) == 2
+    for got, ref in zip(ns["MODES"], reference):
+        for a, b in ((got.A, ref.A), (got.B, ref.B), (got.C, ref.C), (got.D, ref.D)):
+            np.testing.assert_array_equal(a, b)
+        assert got.dt == ref.dt == pytest.approx(0.01)
+        assert isinstance(got, control.StateSpace)
+    mat = tmp_path / "m.mat"
+    assert main(["export", str(files / "good.json"), "--format", "matlab", "--out", str(mat)]) == 0
+    m = loadmat(mat)
+    assert m["A"].shape == (4, 4, 2) and m["B"].shape == (4, 2, 2) and m["c"].shape == (1, 2)
+    np.testing.assert_allclose(m["A"][:, :, 1], reference[1].A)
+    np.testing.assert_allclose(np.column_stack([m["B"][:, :, 0], m["e"][:, :, 0]]), reference[0].B)
+    assert float(m["Ts"].ravel()[0]) == pytest.approx(0.01) and m["H"].shape == (2, 1)
+    js = tmp_path / "m.json"
+    assert main(["export", str(files / "good.json"), "--format", "json", "--out", str(js)]) == 0
+    doc = json.loads(js.read_text())
+    assert doc["schema"] == "hwpts.statespace/1" and len(doc["modes"]) == 2
+    np.testing.assert_allclose(doc["modes"][0]["A"], reference[0].A)
+    capsys.readouterr()
+    assert main(["export", str(files / "good.json"), "--format", "matlab", "--out", str(tmp_path / "x.json")]) == 2
+    assert "writes a .mat file" in capsys.readouterr().err
+
+
+def test_a_model_file_without_the_signals_section_still_loads(files, tmp_path):
+    from hwpts.io.models import REQUIRED_SECTIONS, checksum
+
+    doc = json.loads((files / "good.json").read_text())
+    del doc["signals"]
+    doc["checksum"] = {"algorithm": "sha256", "sections": list(REQUIRED_SECTIONS),
+                       "value": checksum(doc, REQUIRED_SECTIONS)}
+    old = tmp_path / "old.json"
+    old.write_text(json.dumps(doc))
+    model = load_model(old)
+    assert model.sample_time_ is None and model.units_ == {}
