@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import shlex
 import signal
 import sys
 import threading
@@ -114,6 +115,7 @@ def _run(parser: ArgumentParser, argv: Sequence[str] | None) -> int:
     """Parse and dispatch; every failure becomes one line and an exit status."""
     try:
         args = parser.parse_args(argv)
+        args.command_line = shlex.join(["hwpts", *(sys.argv[1:] if argv is None else argv)])
         _check_outputs(args)
         status = int(args.handler(args) or EXIT_OK)
     except BaseException as error:

@@ -1,6 +1,7 @@
 """End to end: ``hwpts reproduce --quick`` against the contract of DESIGN.md section 4."""
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -37,6 +38,12 @@ def test_summary_follows_the_contract(quick_run):
     assert s["timings_s"]["total"] > 0
     for stage in ("sweeps", "segmentation", "recording", "identification", "validation", "figures_and_report"):
         assert stage in s["timings_s"]
+    from hwpts import __version__
+
+    run = s["run"]
+    assert run["hwpts_version"] == __version__ and run["seed"] == 0
+    assert re.fullmatch(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ", run["created_utc"])
+    assert run["command"].startswith("hwpts reproduce --quick")
 
 
 def test_quick_run_already_lands_near_the_paper(quick_run):
@@ -86,8 +93,10 @@ def test_same_seed_same_numbers(quick_run, tmp_path):
     assert main(["reproduce", "--quick", "--out", str(other), "--seed", "0"]) == 0
     a = json.loads((quick_run / "summary.json").read_text())
     b = json.loads((other / "summary.json").read_text())
+    assert a["run"]["seed"] == b["run"]["seed"] == 0 and a["run"]["hwpts_version"]
     for s in (a, b):
         s.pop("timings_s")
+        s.pop("run")  # the date differs
         for m in s["methods"].values():
             m.pop("fit_time_s")
     assert a == b

@@ -17,7 +17,12 @@ window.addEventListener('load', () => {
   const table = document.getElementById('fit-table');
   const rows = table ? table.querySelectorAll('tbody tr').length : 0;
   const height = table ? Math.round(table.getBoundingClientRect().height) : 0;
-  document.body.setAttribute('data-probe', `images=${ok}/${imgs.length};rows=${rows};table_height=${height}`);
+  const width = document.documentElement.clientWidth;
+  const widest = Math.max(...[...document.querySelectorAll('table')].map(t => Math.ceil(t.getBoundingClientRect().right)));
+  const version = (document.getElementById('hwpts-version') || {}).textContent || '';
+  const created = (document.getElementById('created') || {}).textContent || '';
+  document.body.setAttribute('data-probe', `images=${ok}/${imgs.length};rows=${rows};table_height=${height};` +
+    `widest=${widest};width=${width};scroll=${document.documentElement.scrollWidth};version=${version};created=${created}`);
 });
 </script>"""
 
@@ -35,12 +40,18 @@ def _chromium(tmp_path, *args):
 def test_report_renders_its_figures_and_table(quick_run, tmp_path):
     page = tmp_path / "report.html"
     page.write_text((quick_run / "report.html").read_text().replace("</body>", PROBE + "</body>"))
-    dom = _chromium(tmp_path, "--dump-dom", page.as_uri()).stdout
-    probe = re.search(r'data-probe="images=(\d+)/(\d+);rows=(\d+);table_height=(\d+)"', dom)
+    dom = _chromium(tmp_path, "--window-size=1000,1600", "--dump-dom", page.as_uri()).stdout
+    probe = re.search(r'data-probe="images=(\d+)/(\d+);rows=(\d+);table_height=(\d+);widest=(\d+);width=(\d+);'
+                      r'scroll=(\d+);version=([^;]*);created=([^"]*)"', dom)
     assert probe, "the page did not finish loading"
-    loaded, total, rows, height = map(int, probe.groups())
+    loaded, total, rows, height, widest, width, scroll = map(int, probe.groups()[:7])
+    version, created = probe.groups()[7:]
     assert total == 9 and loaded == total, "a figure failed to decode"
     assert rows >= 6 and height > 100
+    assert widest <= width and scroll <= width, f"a table is wider than the page ({widest} px > {width} px)"
+    from hwpts import __version__
+
+    assert version == __version__ and re.fullmatch(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ", created)
 
 
 def test_report_screenshot_is_not_blank(quick_run, tmp_path):

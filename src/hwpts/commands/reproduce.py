@@ -38,7 +38,7 @@ def reproduce_command(args) -> int:
     from hwpts.io.models import save_model
     from hwpts.reporting.figures import all_figures
     from hwpts.reporting.html import render_report
-    from hwpts.reporting.summary import SCHEMA, build_summary, fit_table
+    from hwpts.reporting.summary import SCHEMA, build_summary, fit_table, run_info
 
     check_replaceable(args.out, SCHEMA)  # refuse before minutes of work
     config = paper.ReproduceConfig.quick_run(args.seed) if args.quick else paper.ReproduceConfig.full(args.seed)
@@ -70,7 +70,8 @@ def reproduce_command(args) -> int:
             for name, model in models.items():
                 save_model(model, stage / "models" / f"{name}.json")
             result.timings_s["figures_and_report"] = time.perf_counter() - t0
-            summary = build_summary(result, time.perf_counter() - start)
+            summary = build_summary(result, time.perf_counter() - start,
+                                    run_info(args.seed, getattr(args, "command_line", None)))
             write_text_atomic(stage / "report.html", render_report(summary, figures, models))
             write_text_atomic(stage / "summary.json", json.dumps(summary, indent=2) + "\n")
         bar.update(1)

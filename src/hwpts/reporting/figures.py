@@ -101,7 +101,8 @@ def fig7_fracture(result) -> bytes:
 
     plt = _pyplot()
     f = result.fracture
-    fig = plt.figure(figsize=(12, 4.8))
+    fig = plt.figure(figsize=(13, 5.2))
+    fig.subplots_adjust(left=0.0, right=0.97, wspace=0.32, top=0.88)
     ax = fig.add_subplot(1, 2, 1, projection="3d")
     vv, ww = np.meshgrid(result.sweeps.voltages_v, result.sweeps.pump_speeds_rpm, indexing="ij")
     ax.plot_wireframe(vv, ww, result.sweeps.average_rpm, color="0.75", linewidth=0.4)
@@ -113,8 +114,8 @@ def fig7_fracture(result) -> bytes:
     ax.scatter(*f.operating_points.T, color="tab:red", s=40, marker="o")
     ax.set_xlabel("valve voltage [V]")
     ax.set_ylabel("pump speed [r/min]")
-    ax.set_zlabel("motor A speed [r/min]")
-    ax.legend(fontsize=7)
+    ax.set_zlabel("motor A speed [r/min]", labelpad=10)
+    ax.legend(fontsize=7, loc="upper left")
     ax.set_title("space line through two fracture points")
     ax2 = fig.add_subplot(1, 2, 2)
     v = np.linspace(1.2, 3.8, 100)
@@ -134,32 +135,51 @@ def fig7_fracture(result) -> bytes:
 
 
 def case_figure(result, case: str) -> bytes:
-    """Figs. 8-11: inputs of a case, then the measured motor A speed beside every model's free run."""
+    """Figs. 8-11: inputs of a case, the measured motor A speed beside every model's free run, and
+    the residual (measured - simulated) of the paper's method and the package's best.
+
+    Legends sit to the right of the axes so that they never cover data.
+    """
     plt = _pyplot()
     data = result.cases[case]
     t = data.time
-    fig, axes = plt.subplots(4, 1, figsize=(9, 10), sharex=True, gridspec_kw={"height_ratios": [1, 1, 2.2, 2.2]})
+    fig, axes = plt.subplots(5, 1, figsize=(11, 12), sharex=True, layout="constrained",
+                             gridspec_kw={"height_ratios": [1, 1, 2.2, 2.2, 1.3]})
+    legend = {"fontsize": 8, "loc": "upper left", "bbox_to_anchor": (1.01, 1.0), "borderaxespad": 0.0}
     axes[0].plot(t, data.extra["valve_voltage_v"], color="k", label="command")
     axes[0].plot(t, data.input("valve_voltage_play_v"), color="tab:purple", linestyle="--", label="compensated (play)")
     axes[0].set_ylabel("valve [V]")
-    axes[0].legend(fontsize=8, loc="upper right")
-    axes[1].plot(t, data.input("pump_speed_rpm"), color="k")
-    axes[1].set_ylabel("pump, measured [r/min]")
+    axes[0].legend(**legend)
+    axes[1].plot(t, data.input("pump_speed_rpm"), color="k", label="pump (measured)")
+    axes[1].set_ylabel("pump [r/min]")
+    axes[1].legend(**legend)
     others = [name for name in result.methods if name not in SHOWN_METHODS]
     palette = itertools.cycle(["tab:green", "tab:brown", "tab:pink", "tab:olive", "tab:cyan", "tab:purple"])
+    colors = {}
     for ax, names in ((axes[2], SHOWN_METHODS), (axes[3], others)):
         ax.plot(t, data.output, color="k", linewidth=2.2, alpha=0.6, label="test bed (measured)")
         for name in names:
             method = result.methods[name]
             color, style = STYLES[name] if name in STYLES else (next(palette), "-")
+            colors[name] = (color, style)
             fit = method.fit_percent[case]
             label = f"{name}: {'diverged' if np.isnan(fit) else f'{fit:.1f} %'}"
             ax.plot(t, method.simulated[case], color=color, linestyle=style, linewidth=1.3, label=label)
         ax.set_ylabel("motor A speed [r/min]")
-        ax.legend(fontsize=8, loc="best")
+        ax.legend(**legend)
     axes[2].set_title("the paper's method, its variants and the package's best", fontsize=9)
     axes[3].set_title("the paper's alternative segmentations and the library's learned partitions", fontsize=9)
-    axes[3].set_xlabel("time [s]")
+    ax = axes[4]
+    for name in ("paper", "best"):
+        if name in result.methods:
+            color, style = colors.get(name, STYLES.get(name, ("k", "-")))
+            ax.plot(t, data.output - result.methods[name].simulated[case], color=color, linestyle=style,
+                    linewidth=1.0, label=f"{name}")
+    ax.axhline(0.0, color="gray", linewidth=0.6)
+    ax.set_ylabel("residual [r/min]")
+    ax.set_title("residual: measured - simulated", fontsize=9)
+    ax.legend(**legend)
+    ax.set_xlabel("time [s]")
     fig.suptitle(CASE_TITLES[case] + " (free-run fit %)")
     return _png(fig)
 

@@ -33,13 +33,21 @@ def _table(summary: dict) -> str:
 
 
 def _coefficients(model, title) -> str:
+    """One row per regressor, one column per region: theta +- its standard error (eq. 17)."""
     names = model.structure_.feature_names + ["offset"]
-    head = "".join(f"<th>{_esc(n)}</th>" for n in names)
+    std = model.parameter_std_
+    modes = model.state_space()
+    head = "".join(f"<th>region {i + 1}<br><span class='sub'>{_esc(model.region_models_[i])}, max |pole| "
+                   f"{ss.max_pole_modulus:.3f}</span></th>" for i, ss in enumerate(modes))
     rows = []
-    for i, (theta, ss) in enumerate(zip(model.theta_, model.state_space())):
-        cells = "".join(f"<td>{v:.5g}</td>" for v in theta)
-        rows.append(f"<tr><th>region {i + 1} ({_esc(model.region_models_[i])}, max |pole| {ss.max_pole_modulus:.3f})</th>{cells}</tr>")
-    return f"<h3>{_esc(title)}</h3><div class='scroll'><table class='coef'><thead><tr><th></th>{head}</tr></thead><tbody>{''.join(rows)}</tbody></table></div>"
+    for j, name in enumerate(names):
+        cells = "".join(
+            f"<td>{model.theta_[i, j]:.5g}" + (f" <span class='sub'>&plusmn; {std[i, j]:.2g}</span>"
+                                               if np.isfinite(std[i, j]) else "") + "</td>"
+            for i in range(len(modes)))
+        rows.append(f"<tr><th>{_esc(name)}</th>{cells}</tr>")
+    return (f"<h3>{_esc(title)}</h3><table class='coef'><thead><tr><th>regressor</th>{head}</tr></thead>"
+            f"<tbody>{''.join(rows)}</tbody></table>")
 
 
 def findings(summary: dict) -> list[str]:
@@ -78,6 +86,13 @@ def findings(summary: dict) -> list[str]:
     return out
 
 
+def _run_line(summary: dict) -> str:
+    run = summary.get("run") or {}
+    command = f", command <code>{_esc(run['command'])}</code>" if run.get("command") else ""
+    return (f"<p class='run' id='run'>hwpts <span id='hwpts-version'>{_esc(run.get('hwpts_version', '?'))}</span>, "
+            f"<span id='created'>{_esc(run.get('created_utc', '?'))}</span>{command}, seed {_esc(summary['seed'])}</p>")
+
+
 def render_report(summary: dict, figures: dict[str, bytes], models: dict) -> str:
     """The report as one HTML string."""
     ss = summary["steady_state"]
@@ -97,18 +112,22 @@ def render_report(summary: dict, figures: dict[str, bytes], models: dict) -> str
     )
     timings = ", ".join(f"{k} {v:.1f} s" for k, v in summary["timings_s"].items())
     notes = "".join(f"<li>{_esc(s)}</li>" for s in findings(summary))
-    coef = _coefficients(models["paper"], "Method 'paper': identified coefficients (eq. 17), the paper's eq. 18 re-identified") + \
-        _coefficients(models["best"], "Method 'best': identified coefficients")
+    coef = _coefficients(models["paper"], "Method 'paper': identified coefficients (eq. 17) +- standard error, the "
+                                          "paper's eq. 18 re-identified") + \
+        _coefficients(models["best"], "Method 'best': identified coefficients +- standard error")
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>hwpts reproduce: PWA identification of the HWPTS</title>
 <style>
-body {{ font-family: system-ui, sans-serif; max-width: 1100px; margin: 2em auto; color: #222; line-height: 1.45; }}
+body {{ font-family: system-ui, sans-serif; max-width: 1100px; margin: 2em auto; padding: 0 1em; color: #222; line-height: 1.45; }}
+* {{ box-sizing: border-box; }}
 table {{ border-collapse: collapse; margin: 0.8em 0; }} th, td {{ border: 1px solid #ccc; padding: 3px 8px; text-align: right; }}
 td.desc {{ text-align: left; font-size: 0.85em; color: #555; }} td.good {{ background: #e3f4e3; }} tr.paper {{ background: #f3f3f3; }}
 figure {{ margin: 1.2em 0; }} img {{ max-width: 100%; border: 1px solid #ddd; }} figcaption {{ font-size: 0.8em; color: #666; }}
-.scroll {{ overflow-x: auto; }} table.coef td {{ font-family: monospace; font-size: 0.8em; }}
+table.coef td {{ font-family: monospace; font-size: 0.8em; }} .sub {{ font-size: 0.8em; color: #666; font-weight: normal; }}
+p.run {{ font-size: 0.85em; color: #555; }} code {{ word-break: break-all; }}
 </style></head><body>
 <h1>Piecewise affine identification of a hydraulic wind power transfer system</h1>
+{_run_line(summary)}
 <p>A reproduction of Vaezi &amp; Izadian, <i>Piecewise Affine System Identification of a Hydraulic Wind Power Transfer
 System</i>, on hwpts' physical simulator of the test bed (seed {summary['seed']}{', quick run' if summary['quick'] else ''}).</p>
 <h2>Fit of every model on the four validation cases</h2>

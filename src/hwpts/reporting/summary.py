@@ -16,8 +16,22 @@ def _number(x, digits=3):
     return None if x is None or (isinstance(x, float) and math.isnan(x)) else round(float(x), digits)
 
 
-def build_summary(result, total_time_s: float) -> dict:
-    """The summary as a JSON-ready dict; a diverged free run is ``null`` with ``"diverged": true``."""
+def run_info(seed: int, command: str | None = None) -> dict:
+    """Who made a result and how: hwpts version, UTC date, command line and seed."""
+    import datetime
+
+    from hwpts import __version__
+
+    now = datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0)
+    return {"hwpts_version": __version__, "created_utc": now.isoformat().replace("+00:00", "Z"),
+            "command": command, "seed": int(seed)}
+
+
+def build_summary(result, total_time_s: float, run: dict | None = None) -> dict:
+    """The summary as a JSON-ready dict; a diverged free run is ``null`` with ``"diverged": true``.
+
+    ``run``: :func:`run_info` (version, date, command line, seed), stored under ``"run"``.
+    """
     methods = {}
     for name, m in result.methods.items():
         cases = {}
@@ -40,6 +54,7 @@ def build_summary(result, total_time_s: float) -> dict:
     timings["total"] = round(total_time_s, 3)
     return {
         "schema": SCHEMA,
+        "run": run if run is not None else run_info(result.config.seed),
         "seed": result.config.seed,
         "quick": result.config.quick,
         "sample_time_s": result.config.sample_time_s,
