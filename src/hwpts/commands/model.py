@@ -67,7 +67,7 @@ def _sample_time(data, path, tname) -> float | None:
     if data.n_samples < 2:
         return None
     steps = np.diff(data.time)
-    dt = float(np.median(steps))
+    dt = float(f"{float(np.median(steps)):.12g}")  # 0.01, not 0.009999999999999787 from the time column's rounding
     worst = float(np.max(np.abs(steps - dt)))
     if worst > 0.01 * dt:
         row = int(np.argmax(np.abs(steps - dt))) + 1
