@@ -40,8 +40,9 @@ def register(subparsers) -> None:
     r.add_argument("--controllers", default=DEFAULT_CONTROLLERS, metavar="A,B,...",
                    help=f"comma-separated controller names (default: {DEFAULT_CONTROLLERS})")
     r.add_argument("--model", metavar="MODEL.json", help="PWARX model file with inputs (valve voltage, pump speed)")
-    r.add_argument("--model-sample-time", type=_positive, default=0.05, metavar="S",
-                   help="the model's sample period in seconds (default 0.05, that of 'hwpts reproduce')")
+    r.add_argument("--model-sample-time", type=_positive, default=None, metavar="S",
+                   help="the model's sample period in seconds (default: the one in the model file, else 0.05, "
+                        "that of 'hwpts reproduce')")
     r.add_argument("--hysteresis-width", type=finite_float, default=None, metavar="V",
                    help="half-width of the valve's play the model's valve input was compensated with [V] "
                    "(default: read off the sweeps when identifying, else 0.25)")
@@ -64,7 +65,8 @@ def register(subparsers) -> None:
     st.add_argument("--controllers", default="pi,scheduled,mpc", metavar="A,B,...",
                     help="controllers (default pi,scheduled,mpc; pi is the baseline of the targets)")
     st.add_argument("--model", metavar="MODEL.json", help="PWARX model file (default: identified as 'hwpts reproduce' does)")
-    st.add_argument("--model-sample-time", type=_positive, default=0.05, metavar="S", help="the model's sample period (default 0.05 s)")
+    st.add_argument("--model-sample-time", type=_positive, default=None, metavar="S",
+                    help="the model's sample period (default: the one in the model file, else 0.05 s)")
     st.add_argument("--hysteresis-width", type=finite_float, default=None, metavar="V", help="the model's play half-width [V]")
     st.add_argument("--duration", type=_positive, default=None, metavar="S", help="record length (default: the scenario's, 600 s)")
     st.add_argument("--seed", type=non_negative_int, default=0, metavar="N", help="seed of the plant draws (default 0)")
@@ -107,7 +109,13 @@ def _model_bank(args):
     if args.model:
         model = load_model(args.model)
         half_width = 0.25 if args.hysteresis_width is None else args.hysteresis_width
-        return model, model_to_dict(model), args.model_sample_time, half_width, f"file {args.model}"
+        known = getattr(model, "sample_time_", None)
+        dt = args.model_sample_time if args.model_sample_time is not None else (known or 0.05)
+        if known is not None and abs(dt - known) > 0.01 * known:
+            from hwpts.errors import ParameterError
+
+            raise ParameterError(f"--model-sample-time {dt:g}: the model file says it was fitted at {known:g} s")
+        return model, model_to_dict(model), dt, half_width, f"file {args.model}"
     print("identifying the model bank as 'hwpts reproduce' does (method 'paper') ...", file=sys.stderr)
     model, r_hat, sample_time = identify_model_bank(args.seed)
     half_width = r_hat if args.hysteresis_width is None else args.hysteresis_width

@@ -85,12 +85,15 @@ class PartitionLearner:
         from hwpts.identification.local_models import fit_local_models
 
         labels = np.asarray(labels, dtype=np.int64)
-        partition = fit_linear_partition(X, labels, s, C=self.C, columns=columns)
-        train_X, train_labels = X, labels
+        rng = np.random.default_rng(self.random_state)
+        # the first classifier on at most classifier_rows rows drawn at random (every region kept):
+        # far more rows hardly move a logistic boundary and cost a Newton step each
+        first = self._subsample(labels, s, rng)
+        train_X, train_labels = X[first], labels[first]
+        partition = fit_linear_partition(train_X, train_labels, s, C=self.C, columns=columns)
         labels = partition.predict(X)
         rounds = self.refinement_rounds if s > 1 else 0
         p = X.shape[1] + 1
-        rng = np.random.default_rng(self.random_state)
         for _ in range(rounds):
             labels, s = drop_empty_regions(labels, s)
             if s == 1:
@@ -164,6 +167,19 @@ class PartitionLearner:
             if int(np.sum(reduced.predict(X) != labels)) <= errors_full + max(1, int(0.001 * labels.size)):
                 return reduced, np.flatnonzero(used)
         return None
+
+    def _subsample(self, labels, s, rng):
+        """Indices of at most ``classifier_rows`` rows drawn at random, all rows of a small region kept."""
+        n = labels.size
+        limit = int(self.classifier_rows)
+        if n <= limit:
+            return np.arange(n)
+        keep = np.zeros(n, dtype=bool)
+        keep[rng.choice(n, limit, replace=False)] = True
+        counts = np.bincount(labels, minlength=s)
+        for r in np.flatnonzero((counts > 0) & (np.bincount(labels[keep], minlength=s) < 50)):
+            keep[labels == r] = True  # a rare region keeps every row it has
+        return np.flatnonzero(keep)
 
     def _informative(self, mask, logp, rng):
         """At most ``classifier_rows`` rows of ``mask`` for the classifier: the half nearest the

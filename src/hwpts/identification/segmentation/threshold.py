@@ -77,11 +77,29 @@ def _block_sse(CG, Cb, Cy, a, b, ridge):
     return np.maximum(yy - np.einsum("ni,ni->n", r, theta), 0.0)
 
 
-def optimal_split(x, Phi, y, n_regions, min_rows, n_grid=200):
-    """Exact least-squares split of the rows into ``n_regions`` intervals of ``x`` (module doc).
+_COST_CACHE: dict = {}  # fingerprint of (x, Phi, y, min_rows, n_grid) -> block costs (see _split_costs)
+_COST_CACHE_SIZE = 48
 
-    Returns ``(sse, thresholds)``; ``sse`` is ``inf`` when no admissible split exists.
-    """
+
+def _fingerprint(*arrays) -> bytes:
+    import hashlib
+
+    h = hashlib.blake2b(digest_size=16)
+    for a in arrays:
+        a = np.ascontiguousarray(a)
+        h.update(str((a.shape, a.dtype.str)).encode())
+        h.update(a.data)
+    return h.digest()
+
+
+def _split_costs(x, Phi, y, min_rows, n_grid):
+    """Sorted ``x``, the candidate block boundaries and the least-squares cost of every admissible
+    block between two of them. They do not depend on the number of regions: a model search that
+    grows the regions on the same rows reuses them (a small cache keyed by the data's hash)."""
+    key = (_fingerprint(x, Phi, y), int(min_rows), int(n_grid))
+    hit = _COST_CACHE.get(key)
+    if hit is not None:
+        return hit
     n, p = Phi.shape
     order = np.argsort(x, kind="stable")
     xs, P, ys = x[order], Phi[order], y[order]
@@ -89,20 +107,36 @@ def optimal_split(x, Phi, y, n_regions, min_rows, n_grid=200):
     Cb = np.concatenate([np.zeros((1, p)), np.cumsum(P * ys[:, None], axis=0)])
     Cy = np.concatenate([[0.0], np.cumsum(ys**2)])
     ridge = 1e-10 * float(np.trace(CG[-1])) / p
+    whole = float(_block_sse(CG, Cb, Cy, np.array([0]), np.array([n]), ridge)[0])
     changes = np.flatnonzero(xs[1:] > xs[:-1]) + 1  # a cut at k splits rows [0, k) | [k, n)
     changes = changes[(changes >= min_rows) & (changes <= n - min_rows)]
     if n > EXACT_ROWS and changes.size > n_grid:
         pick = np.unique(np.searchsorted(changes, np.quantile(changes, np.linspace(0, 1, n_grid))))
         changes = changes[np.clip(pick, 0, changes.size - 1)]
         changes = np.unique(changes)
-    if n_regions == 1:
-        return float(_block_sse(CG, Cb, Cy, np.array([0]), np.array([n]), ridge)[0]), []
     nodes = np.concatenate([[0], changes, [n]])  # block boundaries
     m = nodes.size
     ia, ib = np.triu_indices(m, k=1)
     ok = (nodes[ib] - nodes[ia]) >= min_rows
     cost = np.full((m, m), np.inf)
     cost[ia[ok], ib[ok]] = _block_sse(CG, Cb, Cy, nodes[ia[ok]], nodes[ib[ok]], ridge)
+    out = (xs, nodes, cost, whole)
+    if len(_COST_CACHE) >= _COST_CACHE_SIZE:
+        _COST_CACHE.pop(next(iter(_COST_CACHE)))
+    _COST_CACHE[key] = out
+    return out
+
+
+def optimal_split(x, Phi, y, n_regions, min_rows, n_grid=200):
+    """Exact least-squares split of the rows into ``n_regions`` intervals of ``x`` (module doc).
+
+    Returns ``(sse, thresholds)``; ``sse`` is ``inf`` when no admissible split exists.
+    """
+    xs, nodes, cost, whole = _split_costs(np.asarray(x, dtype=float), np.asarray(Phi, dtype=float),
+                                          np.asarray(y, dtype=float), min_rows, n_grid)
+    if n_regions == 1:
+        return whole, []
+    m = nodes.size
     # D[j] = best cost of covering rows [0, nodes[j]) with the blocks so far
     D = cost[0].copy()
     back = []
