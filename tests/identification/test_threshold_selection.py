@@ -128,3 +128,39 @@ def test_blocked_split_drops_the_regressor_rows_spanning_the_gap():
     dirty = PWARX(1, 1, 1, n_regions=1, segmentation="average").fit(u, joined)
     # with the break, the junction row is gone; without it, it pulls the least squares
     assert clean.region_counts_[0] == dirty.region_counts_[0] - 1
+
+
+def test_a_method_that_trails_twice_stops_growing():
+    search = PWARXSearch(patience=2)
+
+    def rows(alt_free, alt_one):
+        return [{"params": {"segmentation": "threshold"}, "mean_fit_percent": 96.0, "mean_one_step_fit_percent": 99.5},
+                {"params": {"segmentation": "alternating"}, "mean_fit_percent": alt_free,
+                 "mean_one_step_fit_percent": alt_one}]
+
+    behind = {"threshold": 0, "alternating": 0}
+    active = ["threshold", "alternating"]
+    # close in free run (within 2 points): kept, whatever the one-step fit
+    assert search._still_racing(rows(95.0, 99.0), active, behind) == active
+    # far in free run but as good one step ahead (misfit 0.55 vs 0.5): kept
+    assert search._still_racing(rows(80.0, 99.45), active, behind) == active
+    # far in both, twice in a row: dropped; a diverged candidate (None) trails
+    assert search._still_racing(rows(90.0, 99.0), active, behind) == active
+    assert search._still_racing(rows(None, None), active, behind) == ["threshold"]
+
+
+def test_threshold_costs_are_reused_across_region_counts():
+    from hwpts.identification.segmentation import threshold as th
+
+    rng = np.random.default_rng(3)
+    x = rng.uniform(-1, 1, 3000)
+    Phi = np.column_stack([x, np.ones_like(x)])
+    y = np.where(x > 0.2, 2 * x, -x) + 0.01 * rng.standard_normal(x.size)
+    th._COST_CACHE.clear()
+    first = th.optimal_split(x, Phi, y, 2, 50)
+    assert len(th._COST_CACHE) == 1
+    third = th.optimal_split(x, Phi, y, 3, 50)
+    assert len(th._COST_CACHE) == 1  # the same rows: the block costs were reused
+    th._COST_CACHE.clear()
+    assert th.optimal_split(x, Phi, y, 3, 50) == third and th.optimal_split(x, Phi, y, 2, 50) == first
+    assert abs(first[1][0] - 0.2) < 0.02

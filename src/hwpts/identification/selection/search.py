@@ -58,6 +58,10 @@ ORDER_KEYS = ("output_order", "input_order", "input_delay")
 MIN_BLOCK = 10  # samples of a held-out block, beyond the initial conditions
 REGION_CAP = 10  # most regions the adaptive search tries (max_regions="auto")
 PRUNE_MARGIN = 10.0  # points below the best so far at which a candidate's remaining blocks are skipped
+# a method trailing the leader of its region count by 2 points of free-run fit AND by 20 % in
+# one-step misfit (100 - fit), `patience` counts in a row, is not tried with more regions
+DROP_MARGIN = (2.0, 1.2)
+
 # methods' settings in the adaptive search: thresholds on any column, restarts as the data need
 METHOD_PARAMS = {"threshold": {"column": None}, "alternating": {"n_restarts": "auto"}}
 
@@ -370,12 +374,15 @@ class PWARXSearch(BaseEstimator):
             if self.max_regions != "auto":
                 top = min(n_train // (3 * p), int(self.max_regions))
             misses = 0
+            active = list(methods)
+            behind = dict.fromkeys(methods, 0)
             for s in range(2, max(top, 1) + 1):
                 cands = [{**orders, "segmentation": m, "n_regions": s,
-                          "segmentation_params": METHOD_PARAMS.get(m)} for m in methods]
+                          "segmentation_params": METHOD_PARAMS.get(m)} for m in active]
                 overall = max((self._score(r) for r in table), default=-np.inf)
                 rows = self._run(base, cands, u, y, splits, "regions", bar, overall)
                 table.extend(rows)
+                active = self._still_racing(rows, active, behind)
                 stage_best = max((self._score(r) for r in rows), default=-np.inf)
                 stage_one = max((r["mean_one_step_fit_percent"] or -np.inf for r in rows), default=-np.inf)
                 # grow while the free run or the one-step prediction improves: on a system whose
@@ -388,6 +395,26 @@ class PWARXSearch(BaseEstimator):
                     if misses >= self.patience:
                         break
         return table
+
+    def _still_racing(self, rows, active, behind):
+        """The methods tried with more regions: a method that trails the best of this region count
+        by ``DROP_MARGIN`` (2 points of free-run fit and 20 % more one-step misfit), ``patience``
+        counts in a row, stops (its growth would cost the most and not win)."""
+        if len(active) < 2:
+            return active
+        free = {r["params"]["segmentation"]: self._score(r) for r in rows}
+        one = {r["params"]["segmentation"]: (r["mean_one_step_fit_percent"]
+                                             if r["mean_one_step_fit_percent"] is not None else -np.inf)
+               for r in rows}
+        lead_free, lead_one = max(free.values()), max(one.values())
+        keep = []
+        for m in active:
+            trails = (free.get(m, -np.inf) < lead_free - DROP_MARGIN[0]
+                      and 100.0 - one.get(m, -np.inf) > DROP_MARGIN[1] * (100.0 - lead_one))
+            behind[m] = behind[m] + 1 if trails else 0
+            if behind[m] < max(int(self.patience), 1):
+                keep.append(m)
+        return keep or active[:1]
 
     @staticmethod
     def _same_orders(row, orders) -> bool:
