@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: install reproduce test bench readme readme-control clean
+.PHONY: install reproduce test bench readme readme-control docs clean
 
 install: $(STAMP)
 
@@ -19,6 +19,12 @@ reproduce: install
 
 test: install
 	$(BIN)/python -m pytest -q
+
+# the API reference and user guide, offline, into docs/_build/html (sphinx installed into .venv)
+docs: install
+	$(BIN)/python -m pip install --quiet -e ".[docs]"
+	$(BIN)/python -m sphinx -b html -j 1 --keep-going docs docs/_build/html
+	@echo "open docs/_build/html/index.html"
 
 bench: install
 	$(BIN)/python -m benchmarks

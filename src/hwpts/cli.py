@@ -27,6 +27,7 @@ class ArgumentParser(argparse.ArgumentParser):
     """An argparse parser whose errors are one line, raised rather than printed."""
 
     def error(self, message: str):  # noqa: D102 - argparse hook
+        """Raise the parse error as a :class:`UsageError` (one line, exit 2) instead of printing usage."""
         raise UsageError(f"{self.prog}: {message}")
 
 

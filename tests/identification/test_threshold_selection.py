@@ -144,9 +144,10 @@ def test_a_method_that_trails_twice_stops_growing():
     assert search._still_racing(rows(95.0, 99.0), active, behind) == active
     # far in free run but as good one step ahead (misfit 0.55 vs 0.5): kept
     assert search._still_racing(rows(80.0, 99.45), active, behind) == active
-    # far in both, twice in a row: dropped; a diverged candidate (None) trails
+    # far in both, twice in a row: dropped; a diverged or pruned candidate (None) is no evidence
     assert search._still_racing(rows(90.0, 99.0), active, behind) == active
-    assert search._still_racing(rows(None, None), active, behind) == ["threshold"]
+    assert search._still_racing(rows(None, None), active, behind) == active
+    assert search._still_racing(rows(90.0, 99.0), active, behind) == ["threshold"]
 
 
 def test_threshold_costs_are_reused_across_region_counts():

@@ -7,6 +7,7 @@ from hwpts.errors import ParameterError
 
 
 def cmd_residuals(args) -> int:
+    """``hwpts residuals``: residual tests of MODEL on DATA; prints a verdict per test (or JSON), optionally a figure."""
     from hwpts.commands.model import _model_and_data
     from hwpts.identification.analysis import residual_analysis
 
@@ -41,6 +42,7 @@ def cmd_residuals(args) -> int:
 
 
 def cmd_export(args) -> int:
+    """``hwpts export``: write MODEL's per-mode state space as a python-control module, a .mat file or JSON."""
     from hwpts import __version__
     from hwpts.identification.analysis import state_space_export
     from hwpts.io.export import EXPORT_FORMATS, write_export
@@ -61,6 +63,7 @@ def cmd_export(args) -> int:
 
 
 def register(subparsers):
+    """Add the ``residuals`` and ``export`` sub-commands to ``subparsers``."""
     import argparse
 
     from hwpts.commands._args import finite_float, positive_int

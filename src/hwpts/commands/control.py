@@ -27,6 +27,7 @@ def _count(text):
 
 
 def register(subparsers) -> None:
+    """Add the ``control run`` and ``control study`` sub-commands to ``subparsers``."""
     p = subparsers.add_parser("control", help="closed-loop speed control from an identified model bank",
                               description="Design speed controllers from a PWARX model bank and run them closed loop "
                               "on the simulated test bed under wind and load disturbances.")
@@ -127,6 +128,7 @@ STUDY_SCHEMA = "hwpts.control-study/1"
 
 
 def study_command(args) -> int:
+    """``hwpts control study``: perturbed plants x wind seeds x controllers mapped over Dask; writes results.parquet and summary.json."""
     import json
     import time
 
@@ -172,6 +174,7 @@ def study_command(args) -> int:
 
 
 def run_command(args) -> int:
+    """``hwpts control run``: the controllers closed loop on one scenario; writes summary.json, data, figures and report.html."""
     import json
     import time
 

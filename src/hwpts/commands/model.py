@@ -1,4 +1,4 @@
-"""``hwpts identify | validate | predict``: PWARX models from data files (DESIGN.md section 3)."""
+"""``hwpts identify | validate | predict``: PWARX models from data files (the command-line contract)."""
 
 from __future__ import annotations
 
@@ -181,6 +181,7 @@ def _orders_to_search(args):
 
 
 def cmd_identify(args) -> int:
+    """``hwpts identify``: fit a PWARX model (what is not given is chosen by :class:`PWARXSearch`), write it, print a JSON summary."""
     from hwpts.identification import PWARX, PWARXSearch
     from hwpts.identification.partition import Hyperplane
     from hwpts.identification.regressors import RegressorStructure
@@ -307,6 +308,7 @@ def _model_and_data(args):
 
 
 def cmd_validate(args) -> int:
+    """``hwpts validate``: free-run and one-step fit of MODEL on DATA (text or JSON), optionally a figure."""
     model, data = _model_and_data(args)
     result = _validate_numbers(model, data)
     if args.plot is not None:
@@ -346,6 +348,7 @@ def _write_validation_plot(model, data, result, args):
 
 
 def cmd_predict(args) -> int:
+    """``hwpts predict``: write DATA with the model's free-run, one-step or k-step prediction and the active region."""
     from hwpts.io.datasets import write_csv
 
     model, data = _model_and_data(args)
@@ -415,6 +418,7 @@ def _png_path(text: str):
 
 
 def register(subparsers):
+    """Add the ``identify``, ``validate`` and ``predict`` sub-commands to ``subparsers``."""
     import argparse
 
     from hwpts.commands._args import non_negative_float, non_negative_int, positive_int

@@ -67,6 +67,7 @@ def register(subparsers) -> None:
 
 
 def steady_state_command(args) -> int:
+    """``hwpts plant steady-state``: print one steady operating point of the test bed as JSON."""
     from hwpts.plant import PlantParameters, steady_state
 
     result = steady_state(PlantParameters.paper(), args.valve_voltage, args.pump_speed, branch=args.branch)
@@ -86,6 +87,7 @@ MAX_SWEEP_POINTS = 5_000_000  # operating points of one sweep (about 1.5 GiB of 
 
 
 def sweep_command(args) -> int:
+    """``hwpts plant sweep``: up and down steady-state sweeps of the valve command (paper Fig. 3) to a CSV file."""
     from hwpts.experiments.sweeps import sweep_columns
     from hwpts.io.datasets import write_csv
     from hwpts.plant import PlantParameters, sweep
@@ -109,6 +111,7 @@ def sweep_command(args) -> int:
 
 
 def simulate_command(args) -> int:
+    """``hwpts plant simulate``: a transient of the test bed (a validation case or the user's inputs) to a CSV file."""
     from hwpts.errors import DataError
     from hwpts.io.datasets import read_table, write_csv
     from hwpts.plant import TestBed, validation_case

@@ -12,6 +12,7 @@ from hwpts.commands._args import non_negative_int
 
 
 def register(subparsers) -> None:
+    """Add the ``reproduce`` sub-command to ``subparsers``."""
     p = subparsers.add_parser(
         "reproduce",
         help="the paper end to end on the simulated test bed",
@@ -28,6 +29,7 @@ def register(subparsers) -> None:
 
 
 def reproduce_command(args) -> int:
+    """``hwpts reproduce``: the paper end to end; writes the run folder atomically and prints the fit table."""
     from tqdm import tqdm
 
     from hwpts.experiments import paper

@@ -38,12 +38,14 @@ def _time_until_within(t, err, start, stop, band):
 
 
 def reversals(command: np.ndarray) -> int:
+    """Number of direction changes of the valve ``command`` [V] (steps smaller than the reversal threshold ignored)."""
     d = np.diff(command)
     d = d[np.abs(d) > REVERSAL_MIN_V]
     return int(np.sum(np.sign(d[1:]) != np.sign(d[:-1]))) if d.size > 1 else 0
 
 
 def compute_metrics(scenario: Scenario, result: LoopResult, has_modes: bool) -> dict:
+    """The control metrics of one closed-loop run (schema ``hwpts.control/1``): RMS and maximum error [% of set-point], time within +-1 % and +-0.5 %, settling, peak deviation, recovery, valve travel and reversals, mode switches, controller time."""
     t = result["time_s"]
     sp = result["setpoint_rpm"]
     y = result["motor_a_speed_rpm"]

@@ -104,10 +104,12 @@ class ModelBank:
     # -- structure --------------------------------------------------------------------------
     @property
     def n_regions(self) -> int:
+        """Number of modes of the bank."""
         return self.theta.shape[0]
 
     @property
     def n_features(self) -> int:
+        """Length of the regressor ``na + nb_1 + nb_2``."""
         return self.na + sum(self.nb)
 
     def regressor(self, y_past, u1, u2) -> np.ndarray:
@@ -124,6 +126,7 @@ class ModelBank:
         return x
 
     def steady_regressor(self, y: float, u1: float, u2: float) -> np.ndarray:
+        """The regressor of a steady operating point: speed ``y`` [r/min], valve ``u1`` [V], pump ``u2`` [r/min] in every lag."""
         return np.concatenate([np.full(self.na, y), np.full(self.nb[0], u1), np.full(self.nb[1], u2)])
 
     def region(self, x) -> int:
@@ -140,6 +143,7 @@ class ModelBank:
         return best
 
     def predict(self, x, region: int) -> float:
+        """One-step prediction [r/min] of mode ``region`` from the regressor ``x`` (paper eq. 5)."""
         th = self.theta[region]
         return float(th[:-1] @ x + (th[-1] if self.constant else 0.0))
 
@@ -154,6 +158,7 @@ class ModelBank:
         return a, b, c, d
 
     def steady_output(self, i: int, u1: float, u2: float) -> float:
+        """Steady-state speed [r/min] of mode ``i`` at valve ``u1`` [V] and pump ``u2`` [r/min] (its DC gain and offset)."""
         a, b, c, d = self._sums(i)
         return (b * u1 + c * u2 + d) / (1.0 - a)
 

@@ -20,6 +20,7 @@ SETPOINT_RANGE_RPM = (300.0, 1400.0)
 
 
 def check_setpoint(bank: ModelBank, setpoint: float, output_range=None) -> None:
+    """Refuse a set-point [r/min] outside the documented range or outside what the model was identified on."""
     lo, hi = SETPOINT_RANGE_RPM
     if output_range is not None:
         lo, hi = max(lo, output_range[0]), min(hi, output_range[1])

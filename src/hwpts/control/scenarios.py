@@ -54,6 +54,7 @@ class Scenario:
 
     @property
     def setpoint(self) -> float:
+        """The initial set-point [r/min]."""
         return float(self.setpoint_rpm[0])
 
 

@@ -78,15 +78,18 @@ class ReproduceConfig:
 
     @classmethod
     def full(cls, seed: int = 0) -> ReproduceConfig:
+        """The full run of ``hwpts reproduce`` with ``seed``."""
         return cls(seed=seed)
 
     @classmethod
     def quick_run(cls, seed: int = 0) -> ReproduceConfig:
+        """A smaller run with the same outputs (shorter identification record, fewer methods), for tests."""
         return cls(seed=seed, quick=True, identification_duration_s=200.0, learned_methods=("alternating",),
                    polish_candidates=False)
 
     @property
     def sample_time_s(self) -> float:
+        """Sample period of the identification data [s]: the logger's period times the decimation."""
         return self.logger_sample_time_s * self.decimation
 
 
@@ -125,7 +128,7 @@ CALIBRATION_POINTS = ((1.8, 904.0, 1566.0), (2.95, 328.0, 489.5), (1.5, 600.0, 1
 
 
 def calibrate(parameters: PlantParameters) -> list[dict]:
-    """The simulator's steady states at the operating points the paper prints (PLANT.md section 6)."""
+    """The simulator's steady states at the operating points the paper prints (docs/plant.md section 6)."""
     from hwpts.plant import steady_state
 
     v, w, paper = (np.array(c) for c in zip(*CALIBRATION_POINTS))

@@ -112,6 +112,7 @@ class ResidualAnalysis:
 
     @property
     def n_samples(self) -> int:
+        """Number of residuals ``N`` (samples after the initial conditions)."""
         return int(self.residuals.shape[0])
 
     def outside_share(self) -> dict:

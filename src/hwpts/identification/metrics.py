@@ -1,4 +1,4 @@
-"""Accuracy measures used across the field (BENCHMARKS.md).
+"""Accuracy measures used across the field.
 
 - :func:`fit_percent`: NRMSE fit ``100 * (1 - ||y - yhat|| / ||y - mean(y)||)``.
 - :func:`rmse`.

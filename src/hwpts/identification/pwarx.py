@@ -107,7 +107,7 @@ class PWARX(BaseEstimator):
     ----------
     structure_ : RegressorStructure
     partition_ : RegionPartition
-    theta_ : ndarray, shape (n_regions_, n_features + 1)
+    theta_ : ndarray, shape (n_regions, n_features + 1)
         Parameters per mode, offset last.
     n_regions_ : int
     region_models_ : tuple of str
@@ -118,11 +118,33 @@ class PWARX(BaseEstimator):
     output_range_ : (float, float)
     input_ranges_ : ndarray, shape (n_inputs, 2)
     segmentation_info_ : dict
-    parameter_cov_ : ndarray, shape (n_regions_, n_features + 1, n_features + 1)
+    parameter_cov_ : ndarray, shape (n_regions, n_features + 1, n_features + 1)
         Covariance of each mode's parameters from its local least squares (eq. 17),
         ``sigma_i^2 (Phi_i' Phi_i)^-1`` with the region's residual variance; ``nan`` where unknown
         (a region with no more samples than parameters). With ``polish`` or ``ridge`` it is the
         least-squares covariance, an approximation.
+    sample_time_ : float or None
+        Sample period [s] of the training data, when known (data at another rate are refused by
+        the command line).
+    units_ : dict
+        Units of the signals by name, when known.
+
+    Examples
+    --------
+    A system that switches where its input changes sign, identified with a threshold:
+
+    >>> import numpy as np
+    >>> rng = np.random.default_rng(0)
+    >>> u = rng.uniform(-1, 1, 300)
+    >>> y = np.zeros(300)
+    >>> for k in range(1, 300):
+    ...     y[k] = (0.5 * y[k-1] + u[k-1] + 0.2) if u[k-1] >= 0 else (-0.4 * y[k-1] + 2 * u[k-1] - 0.1)
+    >>> model = PWARX(1, 1, 1, n_regions=2, segmentation="threshold").fit(u[:, None], y)
+    >>> np.round(model.theta_, 3)
+    array([[-0.4,  2. , -0.1],
+           [ 0.5,  1. ,  0.2]])
+    >>> round(model.score(u[:, None], y), 3)
+    100.0
     """
 
     def __init__(self, output_order=1, input_order=1, input_delay=1, n_regions=2,

@@ -89,6 +89,7 @@ class RegressorStructure:
 
     @property
     def n_inputs(self) -> int:
+        """Number of inputs."""
         return len(self.nb)
 
     @property
@@ -113,6 +114,7 @@ class RegressorStructure:
         return self.max_lag + self.n_parameters
 
     def describe_orders(self) -> str:
+        """The orders as text, such as ``na=5, nb=4, nk=0``."""
         nb = self.nb[0] if len(set(self.nb)) == 1 else list(self.nb)
         nk = self.nk[0] if len(set(self.nk)) == 1 else list(self.nk)
         return f"na={self.na}, nb={nb}, nk={nk}"
@@ -201,6 +203,7 @@ class RegressorStructure:
         return np.hstack([X, np.ones((X.shape[0], 1))])
 
     def to_dict(self) -> dict:
+        """JSON-ready form (orders, names, regressor names) as stored in model files."""
         return {
             "na": self.na, "nb": list(self.nb), "nk": list(self.nk), "constant": self.constant,
             "input_names": list(self.input_names), "output_name": self.output_name,
@@ -209,6 +212,7 @@ class RegressorStructure:
 
     @classmethod
     def from_dict(cls, d: dict) -> RegressorStructure:
+        """The structure from :meth:`to_dict`'s form (validated)."""
         return cls.create(d["na"], d["nb"], d["nk"], len(d["input_names"]), d["constant"],
                           d["input_names"], d["output_name"])
 
@@ -236,6 +240,7 @@ def validate_signals(inputs, output, n_inputs: int | None = None) -> tuple[np.nd
 
 
 def names_or_default(names: Sequence[str] | None, n: int, prefix: str) -> tuple[str, ...]:
+    """``names`` as a tuple of strings, or ``prefix1``, ``prefix2``, and so on when ``names`` is None."""
     if names is None:
         return tuple(f"{prefix}{j + 1}" for j in range(n))
     return tuple(str(x) for x in names)

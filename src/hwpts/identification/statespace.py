@@ -32,6 +32,7 @@ class ModeStateSpace:
 
     @property
     def max_pole_modulus(self) -> float:
+        """Largest pole modulus (0 for a static mode); below 1 is stable."""
         return float(np.max(np.abs(self.poles))) if self.poles.size else 0.0
 
     @property

@@ -1,4 +1,4 @@
-"""The synthetic PWARX benchmark systems of BENCHMARKS.md (Hybrid Identification Toolbox, PARC).
+"""The synthetic PWARX benchmark systems of the literature (Hybrid Identification Toolbox, PARC).
 
 Each generator returns a :class:`SyntheticData` with inputs, output, the true mode of every
 sample (``-1`` for the initial conditions) and the orders to identify it with. Randomness only
@@ -112,7 +112,7 @@ def system5_partition(n_features: int = 6) -> "RegionPartition":
 
 
 def system5(n=2000, sigma=0.05, rng=None):
-    """2 inputs, 3 modes, na = nb = 2, nk = 1 (BENCHMARKS.md system 5); u ~ U[-1, 1]^2.
+    """2 inputs, 3 modes, na = nb = 2, nk = 1 (synthetic system 5); u ~ U[-1, 1]^2.
 
     The equation error enters the recursion; it is simulated as a third input e(k) with
     coefficient 1 through the compiled switching-rule loop, so 10^6 samples take milliseconds.
@@ -155,5 +155,5 @@ SYSTEMS = {1: system1, 2: system2, 3: system3, 4: system4, 5: system5}
 
 
 def make_system(number: int, rng=None, **kwargs) -> SyntheticData:
-    """Data of BENCHMARKS.md system ``number`` (1-5)."""
+    """Data of synthetic system ``number`` (1-5) of this module."""
     return SYSTEMS[number](rng=rng, **kwargs)

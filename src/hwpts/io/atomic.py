@@ -1,6 +1,6 @@
 """Atomic file output: write to a temporary file in the target folder, then rename.
 
-A failed run leaves no half-written file behind (DESIGN.md section 3).
+A failed run leaves no half-written file behind (the command-line contract).
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""PWARX model files: JSON, schema ``"hwpts.pwarx/1"`` (DESIGN.md section 5). No pickle.
+"""PWARX model files: JSON, schema ``"hwpts.pwarx/1"`` (a contract other tools read). No pickle.
 
 A model file holds the orders and signal names (``structure``), one entry per region with its
 parameters ``theta`` (eq. 5, offset last) and model kind, the partition as polyhedra
@@ -93,11 +93,22 @@ def model_to_dict(model) -> dict:
 
 
 def dumps_model(model) -> str:
+    """The model file's text (indented JSON, schema ``hwpts.pwarx/1``)."""
     return json.dumps(model_to_dict(model), indent=1, allow_nan=False) + "\n"
 
 
 def save_model(model, path: str | os.PathLike) -> None:
-    """Write the model file atomically (temporary file, then rename)."""
+    """Write the model file atomically (temporary file, then rename).
+
+    >>> import tempfile, pathlib, numpy as np
+    >>> from hwpts.identification import PWARX
+    >>> u = np.linspace(-1, 1, 200)[:, None]
+    >>> model = PWARX(0, 1, 0, n_regions=1, segmentation="average").fit(u, 3 * u[:, 0] + 1)
+    >>> path = pathlib.Path(tempfile.mkdtemp()) / "m.json"
+    >>> save_model(model, path)
+    >>> np.round(load_model(path).theta_, 6)
+    array([[3., 1.]])
+    """
     from hwpts.io.atomic import write_text_atomic
 
     write_text_atomic(path, dumps_model(model))

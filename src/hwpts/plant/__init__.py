@@ -1,4 +1,4 @@
-"""The simulated HWPTS test bed (PLANT.md): parameters, valve, dynamics, steady state, simulation."""
+"""The simulated HWPTS test bed (docs/plant.md): parameters, valve, dynamics, steady state, simulation."""
 
 from hwpts.plant.dynamics import jacobian, linearize, paper_form, rhs, transfer_poles_zeros
 from hwpts.plant.parameters import PlantParameters

@@ -1,7 +1,7 @@
 """Right-hand side x' = F(x, h, w_p) of the HWPTS, its Jacobian, and the paper's f(x) + g(x) U form.
 
 State x = [P_p, P_mA, P_mB, w_A, w_B] (Pa, Pa, Pa, rad/s, rad/s), inputs U = [h, w_p] (spool [m],
-pump speed command [rad/s]); paper eqs. (1)-(2), PLANT.md sections 2-3.
+pump speed command [rad/s]); paper eqs. (1)-(2), docs/plant.md sections 2-3.
 
 The kernels are compiled with numba and work on one operating point; their ``py_func`` is the same
 code in plain Python (used as the straightforward baseline in the benchmarks).
@@ -57,13 +57,13 @@ _WSYNC = _I["generator_synchronous_speed"]
 
 @numba.njit(cache=True)
 def pump_speed_actual(pump_pressure, pump_speed_command, p):
-    """Pump speed after prime-mover droop: w_p = w_p,cmd - K_droop * D_p * P_p [rad/s] (PLANT.md 2.9)."""
+    """Pump speed after prime-mover droop: w_p = w_p,cmd - K_droop * D_p * P_p [rad/s] (docs/plant.md 2.9)."""
     return pump_speed_command - p[_KDR] * p[_DP] * pump_pressure
 
 
 @numba.njit(cache=True)
 def rhs_into(x, h, wp_cmd, p, dx):
-    """Write F(x, h, w_p,cmd) into dx[0:5]: the full model (relief, make-up, droop), PLANT.md section 2.
+    """Write F(x, h, w_p,cmd) into dx[0:5]: the full model (relief, make-up, droop), docs/plant.md section 2.
 
     With the generator option (K_g > 0, off by default) shaft A also carries the induction
     generator's slip torque K_g * (w_A - w_sync), linear in the slip as below the breakdown torque.
@@ -167,7 +167,7 @@ def jacobian(parameters: PlantParameters, state, spool, pump_speed_command):
 
 
 def paper_form(parameters: PlantParameters, state):
-    """The paper's split x' = f(x) + g(x) U, U = [h, w_p] (eq. 2; PLANT.md section 3).
+    """The paper's split x' = f(x) + g(x) U, U = [h, w_p] (eq. 2; docs/plant.md section 3).
 
     Exact (unregularised) square-root orifices, no droop, no make-up flows. Returns f (5,) and
     g (5, 2). Agrees with :func:`rhs` wherever the orifice pressure drops are well above p_cr and

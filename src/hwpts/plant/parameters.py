@@ -1,6 +1,6 @@
-"""Parameters of the HWPTS test bed (PLANT.md section 5), in SI units.
+"""Parameters of the HWPTS test bed (docs/plant.md section 5), in SI units.
 
-Every field carries the symbol of PLANT.md and its unit. ``PlantParameters.paper()`` gives the
+Every field carries the symbol of docs/plant.md and its unit. ``PlantParameters.paper()`` gives the
 defaults; ``averaged()`` the hysteresis-free valve the paper's PWA model stands for; ``test_bed()``
 the rig as it records data (prime-mover droop on).
 """
@@ -16,14 +16,14 @@ import numpy as np
 from hwpts.errors import ParameterError
 
 DROOP_TEST_BED = 3.37
-"""Prime-mover droop K_droop of the lab rig [(rad/s)/(N m)] (PLANT.md section 5, tuned on the triangle test)."""
+"""Prime-mover droop K_droop of the lab rig [(rad/s)/(N m)] (docs/plant.md section 5, tuned on the triangle test)."""
 
 
 @dataclass(frozen=True)
 class PlantParameters:
     """Physical parameters of the hydraulic wind power transfer system (SI units).
 
-    Tags follow PLANT.md: paper, recon(struction), tuned, assumed, numerical.
+    Tags follow docs/plant.md: paper, recon(struction), tuned, assumed, numerical.
     """
 
     oil_density: float = 870.0
@@ -128,12 +128,12 @@ class PlantParameters:
     # -- constructors -------------------------------------------------------------------------
     @classmethod
     def paper(cls) -> PlantParameters:
-        """The defaults of PLANT.md section 5: hysteretic valve (r = 0.25 V), no droop."""
+        """The defaults of docs/plant.md section 5: hysteretic valve (r = 0.25 V), no droop."""
         return cls()
 
     @classmethod
     def averaged(cls) -> PlantParameters:
-        """The averaged valve (r = 0) the paper's PWA model stands for (PLANT.md section 4)."""
+        """The averaged valve (r = 0) the paper's PWA model stands for (docs/plant.md section 4)."""
         return cls(hysteresis_half_width=0.0)
 
     @classmethod

@@ -18,7 +18,7 @@ from hwpts.errors import ParameterError
 CASE_NAMES = ("case1", "case2", "case3", "case4")
 
 TRIANGLE_PUMP_COMMAND_RPM = 706.5
-"""Pump command of the triangle test: 600 r/min at 1.5 V with the rig's droop (PLANT.md section 5)."""
+"""Pump command of the triangle test: 600 r/min at 1.5 V with the rig's droop (docs/plant.md section 5)."""
 
 
 @dataclass(frozen=True)

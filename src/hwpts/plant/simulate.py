@@ -3,7 +3,7 @@
 The integrator is the L-stable two-stage Rosenbrock method ROS2 (Verwer, Spee, Blom & Hundsdorfer,
 SIAM J. Sci. Comput. 20(4), 1999) with the analytic Jacobian and adaptive steps, compiled with
 numba. It is restarted at every sample instant, where the held inputs jump. The model is
-moderately stiff (eigenvalues from about -7 to -4e4 1/s, PLANT.md section 7): an explicit method
+moderately stiff (eigenvalues from about -7 to -4e4 1/s, docs/plant.md section 7): an explicit method
 needs ~100k steps for 10 s; this one needs a few per sample.
 
 The valve hysteresis (play operator) is applied to the command history *before* integration;
@@ -207,22 +207,27 @@ class PlantResponse:
 
     @property
     def pump_pressure_pa(self):
+        """Pump pressure P_p [Pa] per sample."""
         return self.state[:, 0]
 
     @property
     def motor_a_pressure_pa(self):
+        """Motor A inlet pressure P_A [Pa] per sample."""
         return self.state[:, 1]
 
     @property
     def motor_b_pressure_pa(self):
+        """Motor B inlet pressure P_B [Pa] per sample."""
         return self.state[:, 2]
 
     @property
     def motor_a_speed_rpm(self):
+        """Motor A (generator) speed [r/min] per sample."""
         return self.state[:, 3] * RPM_PER_RAD_S
 
     @property
     def motor_b_speed_rpm(self):
+        """Motor B speed [r/min] per sample."""
         return self.state[:, 4] * RPM_PER_RAD_S
 
 
@@ -370,6 +375,7 @@ class PlantStepper:
 
     @property
     def motor_a_speed_rpm(self) -> float:
+        """Motor A (generator) speed [r/min] now."""
         return float(self._z[3] * RPM_PER_RAD_S)
 
     def pump_speed_rpm(self, pump_speed_command_rpm: float) -> float:

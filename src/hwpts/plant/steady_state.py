@@ -8,7 +8,7 @@ solves of the two branches, each a Newton iteration with analytic derivatives (t
 the branches' implicit dependence on P_p) that falls back to bisection whenever a step would leave
 the bracket, so it always converges. Newton on the full 5-state system cycles across
 the check-valve kink near the fracture line; this cannot. Compiled with numba; the points are independent,
-so a sweep is a map over chunks of points (PLANT.md section 7).
+so a sweep is a map over chunks of points (docs/plant.md section 7).
 """
 
 from __future__ import annotations
@@ -233,22 +233,27 @@ class SteadyState:
 
     @property
     def pump_pressure_pa(self):
+        """Pump pressure P_p [Pa] at each operating point."""
         return self.state[..., 0]
 
     @property
     def motor_a_pressure_pa(self):
+        """Motor A inlet pressure P_A [Pa] at each operating point."""
         return self.state[..., 1]
 
     @property
     def motor_b_pressure_pa(self):
+        """Motor B inlet pressure P_B [Pa] at each operating point."""
         return self.state[..., 2]
 
     @property
     def motor_a_speed_rpm(self):
+        """Motor A (generator) speed [r/min] at each operating point."""
         return self.state[..., 3] * RPM_PER_RAD_S
 
     @property
     def motor_b_speed_rpm(self):
+        """Motor B speed [r/min] at each operating point."""
         return self.state[..., 4] * RPM_PER_RAD_S
 
 
@@ -335,6 +340,7 @@ class SweepResult:
 
     @property
     def points_per_sweep(self) -> int:
+        """Operating points in one sweep (voltages x pump speeds)."""
         return int(self.up_rpm.size)
 
 
@@ -359,7 +365,7 @@ def sweep(
     """Up and down steady-state sweeps of the valve command at every pump speed of the grid.
 
     A sweep with hysteresis is a sequence of steady states of v_eff along the sweep direction
-    (PLANT.md section 7). ``progress=None`` shows a progress bar only on a terminal.
+    (docs/plant.md section 7). ``progress=None`` shows a progress bar only on a terminal.
     """
     v = np.asarray(voltages, dtype=float).reshape(-1)
     w = np.asarray(pump_speeds_rpm, dtype=float).reshape(-1)

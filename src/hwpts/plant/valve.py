@@ -1,6 +1,6 @@
 """The proportional valve: orifice law, voltage -> spool map and the coil's hysteresis.
 
-PLANT.md sections 2 and 4. The hysteresis is a *play* (backlash) operator applied to the command
+docs/plant.md sections 2 and 4. The hysteresis is a *play* (backlash) operator applied to the command
 history before integration, a pure function of that history and its initial output (never hidden
 state inside an ODE right-hand side, which solvers evaluate at trial points).
 """
@@ -21,7 +21,7 @@ chamber at 0 Pa draws a negligible make-up flow (numerical)."""
 
 @numba.njit(cache=True)
 def smooth_max0(x, width):
-    """A smooth max(x, 0): 0.5 * (x + sqrt(x^2 + width^2)); exact as |x| >> width."""
+    """A smooth ``max(x, 0)``: ``0.5 * (x + sqrt(x^2 + width^2))``; exact as ``|x| >> width``."""
     return 0.5 * (x + np.sqrt(x * x + width * width))
 
 
@@ -66,7 +66,7 @@ def orifice_flow(area, pressure_drop, parameters):
 
 
 def spool_position(effective_voltage, parameters):
-    """Spool displacement h [m] from the effective coil command [V] (PLANT.md section 4).
+    """Spool displacement h [m] from the effective coil command [V] (docs/plant.md section 4).
 
     h = h_max * clip((v_eff - V_0) / (V_1 - V_0), 0, 1): V_0 = 1.2 V outlet A fully open,
     V_1 = 3.5 V outlet A closed.

@@ -1,4 +1,4 @@
-"""``summary.json`` of ``hwpts reproduce`` (schema "hwpts.reproduce/1", DESIGN.md section 4)."""
+"""``summary.json`` of ``hwpts reproduce`` (schema "hwpts.reproduce/1"; its keys are a contract other tools read)."""
 
 from __future__ import annotations
 

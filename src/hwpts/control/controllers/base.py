@@ -35,7 +35,7 @@ class PIGains:
 
 
 class HysteresisInverse:
-    """Inverse of the valve's play operator of half-width r (PLANT.md section 4).
+    """Inverse of the valve's play operator of half-width r (docs/plant.md section 4).
 
     To move the play's output to v, the command must be v + r going up and v - r going down; a
     desired change smaller than ``deadband`` holds the command (no reversal on noise). The
@@ -123,6 +123,7 @@ class ModelRateHistory:
         self._count = 0
 
     def fill(self, y: float, u1: float, u2: float) -> None:
+        """Fill the whole history with one operating point (speed [r/min], valve [V], pump [r/min]): a start in steady state."""
         self.y = [y] * self.length
         self.u1 = [u1] * self.length
         self.u2 = [u2] * self.length
@@ -152,6 +153,7 @@ class LowPass:
         self.value = math.nan
 
     def reset(self, value: float) -> None:
+        """Set the filter's state to ``value`` (no transient from zero)."""
         self.value = float(value)
 
     def __call__(self, x: float) -> float:
@@ -177,10 +179,13 @@ class Controller:
 
     @property
     def effective(self) -> float:  # pragma: no cover - overridden
+        """The valve voltage [V] the model sees: the command after the hysteresis inverse (or the command itself)."""
         return math.nan
 
     def reset(self, setpoint: float, speed: float, pump: float, command: float) -> None:  # pragma: no cover
+        """Start in steady state at ``speed`` [r/min] and ``pump`` [r/min] with the valve at ``command`` [V] (bumpless start)."""
         raise NotImplementedError
 
     def step(self, setpoint: float, speed: float, pump: float) -> float:  # pragma: no cover
+        """One 10 ms sample: the valve command [V] for the measured ``speed`` and ``pump`` [r/min] and the ``setpoint`` [r/min]."""
         raise NotImplementedError

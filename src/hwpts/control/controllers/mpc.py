@@ -1,6 +1,7 @@
 """``mpc``: model predictive control on the PWA model bank, a QP on the predicted region sequence.
 
 Every 10 ms sample the controller
+
 1. builds the model-rate history ending now: sliding block means over the model's sample period of
    the measured speed, the compensated valve voltage and the measured pump speed (the way the
    identification data were averaged), so that a pump step is seen within one loop sample;
@@ -8,7 +9,7 @@ Every 10 ms sample the controller
    the valve following the previous plan, and reads the region of every predicted regressor off the
    model's partition (paper eq. 8-9): the predicted region sequence;
 3. with that sequence fixed the prediction is affine in the future valve moves (``moves`` blocks of
-   the horizon), and the QP
+   the horizon), and the QP::
 
        min  sum_i (y_i - r)^2 + lambda sum_j (u_j - u_{j-1})^2
        s.t. u_lo <= u_j <= u_hi,  |u_j - u_prev| <= (j + 1) rate T
@@ -72,9 +73,11 @@ class MPCController(Controller):
 
     @property
     def effective(self) -> float:
+        """The valve voltage [V] after the hysteresis inverse (what the model's valve input stands for)."""
         return self.inverse.effective
 
     def reset(self, setpoint, speed, pump, command):
+        """Start in steady state: fill the model-rate history with the present speed, valve and pump."""
         self.inverse.reset(command)
         for q, v in ((self._y, speed), (self._u1, command), (self._u2, pump)):
             q.clear()
@@ -120,6 +123,7 @@ class MPCController(Controller):
         return a[len(a) - 1 - newest_lag::-self.ratio][::-1]
 
     def step(self, setpoint, speed, pump):
+        """One 10 ms sample: predict over the horizon on the region sequence, solve the QP, apply its first move [V]."""
         self._y.append(speed)
         self._u1.append(self.inverse.effective)
         self._u2.append(pump)

@@ -27,6 +27,7 @@ def nominal_design(bank: ModelBank, setpoint: float, pump: float):
 
 
 def region_gains(bank: ModelBank, region: int, closed_loop_time: float) -> PIGains:
+    """SIMC-tuned PI gains for region ``region`` of the model bank, for the closed-loop time constant ``closed_loop_time`` [s]."""
     d = bank.designs[region]
     tau = d.time_constant_s if math.isfinite(d.time_constant_s) else bank.sample_time
     theta = d.dead_time_s if math.isfinite(d.dead_time_s) else 0.0
@@ -55,6 +56,7 @@ class PIController(Controller):
 
     @property
     def effective(self) -> float:
+        """The valve voltage [V] after the hysteresis inverse."""
         return self.inverse.effective
 
     def _design(self, setpoint):
@@ -66,12 +68,14 @@ class PIController(Controller):
         self._setpoint = setpoint
 
     def reset(self, setpoint, speed, pump, command):
+        """Start without a bump: the integrator holds ``command`` minus the feedforward."""
         self.inverse.reset(command)
         self.speed_filter.reset(speed)
         self._design(setpoint)
         self.law.reset_to(command, self.feedforward, setpoint - speed)
 
     def step(self, setpoint, speed, pump):
+        """One 10 ms sample of the PI law with anti-windup and set-point feedforward; returns the valve command [V]."""
         if setpoint != self._setpoint:
             self._design(setpoint)
         y = self.speed_filter(speed)

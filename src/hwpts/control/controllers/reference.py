@@ -74,6 +74,7 @@ class ReferenceController(Controller):
 
     @property
     def effective(self) -> float:
+        """The valve voltage [V] after the hysteresis inverse."""
         return self.inverse.effective
 
     def set_pump_command(self, pump_command: float) -> None:
@@ -85,12 +86,14 @@ class ReferenceController(Controller):
         return self.inverse.effective_limits[0] if not math.isfinite(u) else u
 
     def reset(self, setpoint, speed, pump, command):
+        """Start without a bump from the plant's own steady-state map at the present pump speed."""
         self.inverse.reset(command)
         self.speed_filter.reset(speed)
         self.feedforward = self._ff(pump)
         self.law.reset_to(command, self.feedforward, setpoint - speed)
 
     def step(self, setpoint, speed, pump):
+        """One 10 ms sample: the plant's steady-state inverse as feedforward plus a PI correction; returns the valve command [V]."""
         if setpoint != self.setpoint:
             if setpoint not in self.maps:
                 self.maps[setpoint] = SteadyStateInverse(self.parameters, setpoint)

@@ -57,6 +57,7 @@ class ScheduledController(Controller):
 
     @property
     def effective(self) -> float:
+        """The valve voltage [V] after the hysteresis inverse."""
         return self.inverse.effective
 
     def _schedule(self) -> int:
@@ -75,6 +76,7 @@ class ScheduledController(Controller):
         return u
 
     def reset(self, setpoint, speed, pump, command):
+        """Start without a bump in the region of the present operating point."""
         self.inverse.reset(command)
         self.speed_filter.reset(speed)
         self.pump_filter.reset(pump)
@@ -91,6 +93,7 @@ class ScheduledController(Controller):
         return self._schedule()
 
     def step(self, setpoint, speed, pump):
+        """One 10 ms sample: choose the region, switch laws bumplessly, apply its PI law with the region's feedforward."""
         y = self.speed_filter(speed)
         w = self.pump_filter(pump)
         if self.history.add(speed, self.inverse.effective, pump):
@@ -132,6 +135,7 @@ class MMACController(ScheduledController):
         self.cost = {i: 0.0 for i in self.laws}
 
     def reset(self, setpoint, speed, pump, command):
+        """Start as the scheduled controller and clear the models' recent prediction costs."""
         super().reset(setpoint, speed, pump, command)
         self.cost = {i: 0.0 for i in self.laws}
 

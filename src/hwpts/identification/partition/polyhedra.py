@@ -76,6 +76,7 @@ class RegionPartition:
 
     @property
     def n_regions(self) -> int:
+        """Number of regions (polyhedra)."""
         return len(self.H)
 
     def violations(self, X: np.ndarray) -> np.ndarray:
@@ -108,6 +109,7 @@ class RegionPartition:
         return np.ascontiguousarray(H_all, dtype=float), np.ascontiguousarray(g_all, dtype=float), row_start
 
     def to_dict(self) -> dict:
+        """JSON-ready form: the kind, the assignment rule and each polyhedron's ``H`` and ``g`` (eq. 9)."""
         return {
             "kind": self.kind,
             "rule": "first region i with H_i x + g_i <= 0; else the least violated",
@@ -116,6 +118,7 @@ class RegionPartition:
 
     @classmethod
     def from_dict(cls, d: dict, n_features: int) -> RegionPartition:
+        """The partition from :meth:`to_dict`'s form over ``n_features`` regressors."""
         H = [np.asarray(p["H"], dtype=float).reshape(-1, n_features) for p in d["polyhedra"]]
         g = [np.asarray(p["g"], dtype=float) for p in d["polyhedra"]]
         return cls(H, g, kind=str(d.get("kind", "polyhedra")))
@@ -239,6 +242,7 @@ class Hyperplane:
         return a, self.offset
 
     def to_dict(self) -> dict:
+        """JSON-ready form: coefficients, offset and the columns they apply to."""
         return {"coefficients": list(self.coefficients), "offset": self.offset,
                 "columns": None if self.columns is None else list(self.columns)}
 

@@ -17,7 +17,7 @@ until the assignment is stable. Several restarts (the first from the Ferrari-Tre
 the others from k-means of ``[z, y]`` with different seeds) keep the best objective. Optionally
 (``anneal=(10, 3)``) each start is first alternated with a larger separability weight (gamma x 10,
 then x 3), which merges fragments of a mode scattered over the regressor space into compact
-regions, and then with ``gamma`` itself (a continuation). On BENCHMARKS.md system 2 (five modes
+regions, and then with ``gamma`` itself (a continuation). On synthetic system 2 (five modes
 from 100 samples) plain starts land in a worse local minimum on 3 of 20 data sets and lose a mode;
 the continuation finds all five on all 20. It is off by default because on real data it moves the
 chosen local minimum as much: it changes the hydraulic actuator's blocked selection from a model
@@ -161,6 +161,7 @@ class AlternatingSegmenter(Segmenter):
         return (*best, objectives)
 
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
+        """Labels from alternating assignment and least squares with restarts (see the module docstring)."""
         self._check_regions(n_regions, X.shape[0])
         s = n_regions
         n = X.shape[0]

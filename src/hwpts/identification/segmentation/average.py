@@ -14,6 +14,7 @@ class AverageSegmenter(Segmenter):
     uses_n_regions = False
 
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
+        """One region holding every row: a single ARX model."""
         from hwpts.identification.partition import RegionPartition
 
         return SegmentationResult(np.zeros(X.shape[0], dtype=np.int64), 1,

@@ -52,6 +52,7 @@ class Segmenter(BaseEstimator):
     learns_partition = False
 
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:  # pragma: no cover
+        """Assign the regressor rows ``X`` with targets ``y`` to ``n_regions`` regions; returns a :class:`SegmentationResult` (labels, and a partition when the method defines one)."""
         raise NotImplementedError
 
     def _check_regions(self, n_regions, n_rows):

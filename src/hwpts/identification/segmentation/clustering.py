@@ -6,7 +6,7 @@
 2. Local least squares on each local dataset gives ``theta_k`` and a residual variance ``V_k``.
 3. Feature vectors ``xi_k = [theta_k, m_k]`` with ``m_k`` the mean regressor of the local dataset.
    Because ``m_k`` is part of the feature, modes with *equal* parameters on *disjoint* regions stay
-   apart (BENCHMARKS.md system 1), which clustering on parameters alone cannot do.
+   apart (synthetic system 1, :mod:`hwpts.identification.synthetic`), which clustering on parameters alone cannot do.
 4. Weighted k-means on the features; the weight of ``xi_k`` is its confidence ``1 / V_k``, so
    local datasets that straddle a boundary ("mixed", large residual) hardly move the centres.
 5. Sample ``k`` gets the cluster of its feature vector.
@@ -65,6 +65,7 @@ class ClusteringSegmenter(Segmenter):
         self.n_init = n_init
 
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
+        """Labels from clustering the local-model features of Ferrari-Trecate et al. (see the module docstring)."""
         self._check_regions(n_regions, X.shape[0])
         p = X.shape[1] + 1
         c = self.n_neighbors if self.n_neighbors is not None else max(2 * p, p + 3)

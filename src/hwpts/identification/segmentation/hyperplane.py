@@ -73,9 +73,11 @@ class HyperplaneSegmenter(Segmenter):
         self.hyperplanes = hyperplanes
 
     def parsed(self) -> list[Hyperplane]:
+        """The hyperplanes as :class:`Hyperplane` objects (strings parsed)."""
         return [hp if isinstance(hp, Hyperplane) else Hyperplane.parse(hp) for hp in self.hyperplanes]
 
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
+        """The decision list of the user's hyperplanes as a fixed partition (m hyperplanes, m + 1 regions)."""
         hps = self.parsed()
         if not hps:
             raise ParameterError(

@@ -2,7 +2,7 @@
 
 Each standardised regression vector ``x_k`` (eq. 7) goes to the cluster with the nearest mean;
 the clusters are the region labels. Fast and simple; it ignores the dynamics, so the local
-models can be poor or unstable (BENCHMARKS.md: a naive k-means PWARX diverges on the actuator data).
+models can be poor or unstable (a naive k-means PWARX diverges on the hydraulic actuator data).
 """
 
 from __future__ import annotations
@@ -13,6 +13,15 @@ from hwpts.identification.segmentation.base import SegmentationResult, Segmenter
 
 
 class KMeansSegmenter(Segmenter):
+    """``kmeans``: k-means on the standardised regressors (optionally with the output); the naive baseline.
+
+    Parameters
+    ----------
+    include_output : bool
+        Cluster ``[x_k, y_k]`` instead of ``x_k``.
+    n_init : int
+        k-means restarts.
+    """
     name = "kmeans"
     learns_partition = True
 
@@ -21,6 +30,7 @@ class KMeansSegmenter(Segmenter):
         self.n_init = n_init
 
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
+        """Labels from k-means on the standardised regressors."""
         self._check_regions(n_regions, X.shape[0])
         Z = standardize(np.column_stack([X, y]) if self.include_output else X)
         labels = kmeans_labels(Z, n_regions, rng, self.n_init)

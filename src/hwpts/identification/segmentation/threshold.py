@@ -180,6 +180,7 @@ class ThresholdSegmenter(Segmenter):
         self.min_share = min_share
 
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
+        """The exact least-squares thresholds on the chosen column (or the best column), as a fixed partition."""
         self._check_regions(n_regions, X.shape[0])
         if not 0 < self.min_share < 1 / max(n_regions, 2) or int(self.n_grid) < 2:
             raise ParameterError(f"threshold: min_share must be in (0, 1/n_regions) and n_grid >= 2; "

@@ -16,6 +16,13 @@ from hwpts.identification.segmentation.base import SegmentationResult, Segmenter
 
 
 class ZScoreSegmenter(Segmenter):
+    """``zscore``: two regions split by the z-score of the observed output at ``threshold`` (the paper's alternative segmentation).
+
+    Parameters
+    ----------
+    threshold : float
+        The split ``z >= threshold`` (default 0: above and below the mean).
+    """
     name = "zscore"
     uses_n_regions = False
 
@@ -23,6 +30,7 @@ class ZScoreSegmenter(Segmenter):
         self.threshold = threshold
 
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
+        """Two regions: rows whose output's z-score is at least ``threshold``, and the rest."""
         if not np.isfinite(self.threshold):
             raise ParameterError(f"zscore threshold must be finite, got {self.threshold!r}")
         sd = float(np.std(y))

@@ -194,6 +194,19 @@ class PWARXSearch(BaseEstimator):
         ``n_regions_fitted``, ``fit_time_s``, ``stage``, ``rank`` (1 = best; diverged/failed last),
         ``chosen``.
     n_splits_ : int
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from hwpts.identification import PWARX, PWARXSearch
+    >>> rng = np.random.default_rng(1)
+    >>> u = rng.uniform(-1, 1, (1500, 1))
+    >>> y = np.where(u[:, 0] > 0.3, 2.0 * u[:, 0], -u[:, 0]) + 0.01 * rng.standard_normal(1500)
+    >>> search = PWARXSearch(PWARX(output_order=0, input_order=1, input_delay=0)).fit(u, y)
+    >>> search.best_estimator_.n_regions_
+    2
+    >>> search.best_params_["n_regions"], round(search.best_score_)  # held-out fit %
+    (2, 95)
     """
 
     def __init__(self, estimator=None, param_grid=None, *, cv=None, methods=DEFAULT_METHODS, orders=None,
@@ -409,7 +422,10 @@ class PWARXSearch(BaseEstimator):
         lead_free, lead_one = max(free.values()), max(one.values())
         keep = []
         for m in active:
-            trails = (free.get(m, -np.inf) < lead_free - DROP_MARGIN[0]
+            if not np.isfinite(free.get(m, -np.inf)):
+                keep.append(m)  # failed, diverged or pruned here: no evidence either way (a method
+                continue        # may fail with few regions and win with more)
+            trails = (free[m] < lead_free - DROP_MARGIN[0]
                       and 100.0 - one.get(m, -np.inf) > DROP_MARGIN[1] * (100.0 - lead_one))
             behind[m] = behind[m] + 1 if trails else 0
             if behind[m] < max(int(self.patience), 1):

@@ -40,9 +40,11 @@ class BlockedSplit:
         self.min_block = int(min_block)
 
     def get_n_splits(self, X=None, y=None, groups=None) -> int:
+        """Number of (train, test) pairs."""
         return self.n_splits
 
     def split(self, X, y=None, groups=None):
+        """Yield ``(train, test)`` index arrays: each contiguous block in turn held out, the rest for training."""
         n = len(X)
         if n // self.n_splits < self.min_block:
             raise ParameterError(f"{n} samples cannot make {self.n_splits} blocks of >= {self.min_block} samples")
@@ -66,9 +68,11 @@ class HoldoutSplit:
         self.test_size = float(test_size)
 
     def get_n_splits(self, X=None, y=None, groups=None) -> int:
+        """Always 1."""
         return 1
 
     def split(self, X, y=None, groups=None):
+        """Yield one ``(train, test)`` pair: the leading rows for training, the last ``test_size`` share held out."""
         n = len(X)
         cut = int(round((1.0 - self.test_size) * n))
         idx = np.arange(n)
