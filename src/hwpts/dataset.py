@@ -13,6 +13,8 @@ import numpy as np
 
 from hwpts.errors import DataError
 
+MAX_ABS_VALUE = 1e100  # largest magnitude of a signal value (its squares, and sums of them, stay finite)
+
 
 @dataclass(frozen=True)
 class IODataset:
@@ -67,6 +69,10 @@ class IODataset:
             if not np.all(np.isfinite(values)):
                 bad = int(np.argmax(~np.isfinite(values)))
                 raise DataError(f"column {label!r} has a non-finite value (NaN or inf) at row {bad}")
+            if label != "time" and np.any(np.abs(values) > MAX_ABS_VALUE):
+                bad = int(np.argmax(np.abs(values) > MAX_ABS_VALUE))
+                raise DataError(f"column {label!r} has the value {values[bad]:.3g} at row {bad}, beyond "
+                                f"+-{MAX_ABS_VALUE:.0e}: its squares would overflow; rescale the signal")
         if n > 1 and not np.all(np.diff(time) > 0):
             bad = int(np.argmax(~(np.diff(time) > 0))) + 1
             raise DataError(f"time must be strictly increasing; it is not at row {bad}")

@@ -2,11 +2,13 @@
 are one line (exit 2); files get the umask's permissions; SIGTERM stops a run like Ctrl-C and leaves
 nothing behind; a staging folder left by a killed run is removed by the next run."""
 
+import json
 import os
 import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -191,3 +193,159 @@ def test_validate_json_is_strict_when_the_free_run_diverges():
 
     assert json.loads(text) == {"fit_percent": None, "rmse": None, "n": 3, "fits": [1.0, None]}
     assert "NaN" not in text and "Infinity" not in text
+
+
+def _tree(root):
+    return {str(p.relative_to(root)): (p.read_bytes() if p.is_file() else None) for p in sorted(root.rglob("*"))}
+
+
+def _start(argv, tmp_path):
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba-cache"))
+    return subprocess.Popen([sys.executable, "-m", "hwpts", *argv], stderr=subprocess.PIPE, stdout=subprocess.PIPE,
+                            text=True, env=env)
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGKILL], ids=["SIGINT", "SIGTERM", "SIGKILL"])
+def test_a_signal_during_reproduce_keeps_the_earlier_run(tmp_path, sig):
+    out = tmp_path / "results"
+    assert main(["reproduce", "--quick", "--out", str(out)]) == 0
+    before = _tree(out)
+    proc = _start(["reproduce", "--quick", "--out", str(out)], tmp_path)
+    time.sleep(2.5)
+    proc.send_signal(sig)
+    _, err = proc.communicate(timeout=120)
+    if proc.returncode == 0:
+        pytest.skip("the run finished before the signal (a very fast machine)")
+    if sig == signal.SIGKILL:
+        assert proc.returncode == -signal.SIGKILL
+    else:
+        assert proc.returncode == 130 and err.strip().splitlines()[-1] == "hwpts: interrupted", err
+        assert "Traceback" not in err
+    assert _tree(out) == before  # the earlier run is intact
+    left = sorted(p.name for p in tmp_path.iterdir() if p.name not in ("results", "numba-cache"))
+    if sig != signal.SIGKILL:
+        assert left == []  # nothing left behind
+    else:  # a killed run cannot clean up; the next run removes its staging folder
+        assert main(["reproduce", "--quick", "--out", str(out)]) == 0
+        assert sorted(p.name for p in tmp_path.iterdir() if p.name not in ("results", "numba-cache")) == []
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGKILL], ids=["SIGINT", "SIGKILL"])
+def test_a_signal_during_a_sweep_keeps_the_earlier_file(tmp_path, sig):
+    out = tmp_path / "sweep.csv"
+    assert main(["plant", "sweep", "--out", str(out), "--voltages", "1.2:3.8:3", "--pump-speeds", "200:1000:3"]) == 0
+    kept = out.read_bytes()
+    proc = _start(["plant", "sweep", "--out", str(out), "--voltages", "1.2:3.8:500", "--pump-speeds", "200:1000:500"],
+                  tmp_path)
+    time.sleep(2.5)
+    proc.send_signal(sig)
+    _, err = proc.communicate(timeout=120)
+    if proc.returncode == 0:
+        pytest.skip("the sweep finished before the signal (a very fast machine)")
+    assert out.read_bytes() == kept
+    if sig == signal.SIGINT:
+        assert proc.returncode == 130 and "Traceback" not in err
+    # after the next run to the same file, no temporary file is left (a killed writer's included)
+    assert main(["plant", "sweep", "--out", str(out), "--voltages", "1.2:3.8:3", "--pump-speeds", "200:1000:3"]) == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) in (["sweep.csv"], ["numba-cache", "sweep.csv"])
+
+
+def test_a_temporary_file_of_a_dead_writer_is_removed(tmp_path):
+    from hwpts.io.atomic import write_text_atomic
+
+    stale = tmp_path / ".m.json.999999999.abc123.json.tmp"  # no such process
+    stale.write_text("half")
+    alive = tmp_path / f".m.json.{os.getpid()}.xyz.json.tmp"  # this process: not touched
+    alive.write_text("mine")
+    write_text_atomic(tmp_path / "m.json", "{}")
+    assert not stale.exists() and alive.exists()
+
+
+def _without_root_rights():
+    """A command prefix that runs hwpts without the rights that let root ignore file permissions
+    (``setpriv`` drops CAP_DAC_OVERRIDE and CAP_DAC_READ_SEARCH); nothing for a normal user."""
+    import shutil
+
+    if os.geteuid() != 0:
+        return []
+    setpriv = shutil.which("setpriv")
+    if setpriv is None:
+        pytest.skip("running as root without setpriv: cannot drop the rights that bypass file permissions")
+    caps = "-dac_override,-dac_read_search"
+    return [setpriv, f"--bounding-set={caps}", f"--inh-caps={caps}"]
+
+
+def test_permission_errors_are_one_line(tmp_path, data_csv):
+    prefix = _without_root_rights()
+    secret = tmp_path / "secret.csv"
+    secret.write_bytes(data_csv.read_bytes())
+    os.chmod(secret, 0o000)
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    os.chmod(locked, 0o555)
+    try:
+        env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba-cache"))
+        for argv, needle in (
+            (["identify", str(secret), *FIT, "--out", str(tmp_path / "m.json")], "secret.csv"),
+            (["identify", str(data_csv), *FIT, "--out", str(locked / "m.json")], "locked"),
+            (["plant", "sweep", "--out", str(locked / "s.csv"), "--voltages", "1.2:3.8:3", "--pump-speeds",
+              "200:1000:3"], "locked"),
+            (["reproduce", "--quick", "--out", str(locked / "results")], "locked"),
+        ):
+            run = subprocess.run([*prefix, sys.executable, "-m", "hwpts", *argv], capture_output=True, text=True,
+                                 env=env, timeout=120)
+            lines = run.stderr.strip().splitlines()
+            assert run.returncode == 2 and len(lines) == 1 and lines[0].startswith("hwpts: "), run.stderr
+            assert needle in lines[0] and "Traceback" not in run.stderr
+        assert list(locked.iterdir()) == [] and not (tmp_path / "m.json").exists()
+    finally:
+        os.chmod(locked, 0o755)
+        os.chmod(secret, 0o644)
+
+
+def test_parquet_outputs_read_back_and_dash_is_standard_output(tmp_path, data_csv, capsys):
+    from hwpts.io.datasets import read_table
+
+    model = tmp_path / "m.json"
+    assert main(["identify", str(data_csv), *FIT, "--out", str(model)]) == 0
+    capsys.readouterr()
+    out = tmp_path / "p.parquet"
+    assert main(["predict", str(model), str(data_csv), "--out", str(out), "--mode", "one-step"]) == 0
+    table = read_table(out, ["y", "y_predicted", "region"])
+    assert out.read_bytes()[:4] == b"PAR1" and table["y_predicted"].shape == (400,)
+    capsys.readouterr()
+    assert main(["predict", str(model), str(data_csv), "--out", "-", "--mode", "one-step"]) == 0
+    printed, err = capsys.readouterr()
+    lines = printed.splitlines()
+    assert lines[0] == "time_s,u1,u2,y,y_predicted,region" and len(lines) == 401 and "wrote -" in err
+    np.testing.assert_allclose([float(r.split(",")[4]) for r in lines[1:]], table["y_predicted"], rtol=1e-9)
+    sweep = tmp_path / "s.parquet"
+    assert main(["plant", "sweep", "--out", str(sweep), "--voltages", "1.2:3.8:3", "--pump-speeds", "200:1000:3"]) == 0
+    assert read_table(sweep, ["valve_voltage_v", "motor_a_speed_rpm"])["motor_a_speed_rpm"].shape == (27,)
+    assert not (tmp_path / "-").exists()
+
+
+def test_a_read_only_install_still_runs(tmp_path):
+    """The numba kernels are cached beside the package; on a read-only install (and no writable
+    home) the compiled code falls back without an error or a warning."""
+    import shutil
+
+    import hwpts
+
+    prefix = _without_root_rights()
+    site = tmp_path / "site"
+    shutil.copytree(Path(hwpts.__file__).parent, site / "hwpts",
+                    ignore=shutil.ignore_patterns("__pycache__", "*.nbi", "*.nbc"))
+    for path in [site, *site.rglob("*")]:
+        os.chmod(path, 0o555 if path.is_dir() else 0o444)
+    env = dict(os.environ, PYTHONPATH=str(site), HOME=str(tmp_path / "no-home"))
+    env.pop("NUMBA_CACHE_DIR", None)
+    try:
+        run = subprocess.run([*prefix, sys.executable, "-m", "hwpts", "plant", "steady-state", "--valve-voltage", "2.4",
+                              "--pump-speed", "700"], capture_output=True, text=True, env=env, cwd=tmp_path, timeout=300)
+        assert run.returncode == 0 and run.stderr == "", run.stderr
+        assert json.loads(run.stdout)["motor_a_speed_rpm"] > 1000
+        assert not list((site / "hwpts").rglob("__pycache__"))
+    finally:
+        for path in [site, *site.rglob("*")]:
+            os.chmod(path, 0o755 if path.is_dir() else 0o644)

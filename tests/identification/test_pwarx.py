@@ -241,3 +241,20 @@ def test_dataframes_are_matched_by_column_name():
     np.testing.assert_array_equal(model.predict(frame.to_numpy(), d.output), model.predict(frame, y))
     with pytest.raises(DataError, match=r"no input column\(s\) \['pump'\]"):
         model.predict(frame.rename(columns={"pump": "flow"}), y)
+
+
+def test_complex_and_sparse_input_are_refused():
+    import scipy.sparse
+
+    d = make_system(5, rng=0, n=300)
+    with pytest.raises(DataError, match="inputs is complex"):
+        PWARX(1, 1, 1, n_regions=1, segmentation="average").fit(d.inputs + 1j, d.output)
+    with pytest.raises(DataError, match="y is complex"):
+        PWARX(1, 1, 1, n_regions=1, segmentation="average").fit(d.inputs, d.output + 0j)
+    with pytest.raises(DataError, match="sparse matrix"):
+        PWARX(1, 1, 1, n_regions=1, segmentation="average").fit(scipy.sparse.csr_matrix(d.inputs), d.output)
+    model = PWARX(1, 1, 1, n_regions=1, segmentation="average").fit(d.inputs, d.output)
+    with pytest.raises(DataError, match="X is complex"):
+        model.predict(d.inputs * (1 + 0j), d.output)
+    with pytest.raises(DataError, match="must hold numbers"):
+        model.predict(np.array([["a", "b"]] * 300), d.output)

@@ -68,8 +68,10 @@ def grid(text: str) -> tuple[float, float, int]:
     return start, stop, count
 
 
-def output_file(text: str) -> Path:
-    """A path to write a file at (not an existing folder)."""
+def output_file(text: str) -> Path | str:
+    """A path to write a file at (not an existing folder); ``-`` is standard output."""
+    if text == "-":
+        return text
     path = Path(text)
     if path.is_dir():
         raise argparse.ArgumentTypeError(f"expected a file path, got the folder {text!r}")

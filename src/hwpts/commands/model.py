@@ -57,7 +57,10 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
         # time = sample index of the file (keeps the original numbering under --rows)
         cols["__index__"] = np.arange(len(columns[output_name]), dtype=float)[sl]
         tname = "__index__"
-    data = IODataset.from_columns(cols, list(input_names), output_name, time_name=tname)
+    try:
+        data = IODataset.from_columns(cols, list(input_names), output_name, time_name=tname)
+    except DataError as error:
+        raise DataError(f"{str(path)!r}: {error}") from None
     dt = _sample_time(data, path, tname) if timed else None
     return data, dt
 
@@ -304,6 +307,7 @@ def _model_and_data(args):
     output = args.output or st.output_name
     data, dt = _load_dataset(args.data, inputs, output, args.time, args.rows)
     data = _check_sample_time(model, data, dt, args.data, args.resample)
+    st.check_length(data.n_samples, what=repr(str(args.data)))
     return model, data
 
 
@@ -349,7 +353,9 @@ def _write_validation_plot(model, data, result, args):
 
 def cmd_predict(args) -> int:
     """``hwpts predict``: write DATA with the model's free-run, one-step or k-step prediction and the active region."""
-    from hwpts.io.datasets import write_csv
+    import sys
+
+    from hwpts.io.datasets import is_stdout, write_table
 
     model, data = _model_and_data(args)
     model.structure_.check_length(data.n_samples)
@@ -381,8 +387,9 @@ def cmd_predict(args) -> int:
     columns[name] = data.output
     columns[f"{name}_predicted"] = yhat
     columns["region"] = regions + 1  # 1-based; 0 marks the initial conditions
-    write_csv(args.out, columns)
-    print(f"wrote {args.out} ({data.n_samples} rows, mode {mode}; region 0 = initial conditions)")
+    write_table(args.out, columns)
+    print(f"wrote {args.out} ({data.n_samples} rows, mode {mode}; region 0 = initial conditions)",
+          file=sys.stderr if is_stdout(args.out) else sys.stdout)
     return 0
 
 
@@ -484,7 +491,8 @@ def register(subparsers):
                               description="Free-run (simulate) or one-step predictions of MODEL on DATA.")
     r.add_argument("model", metavar="MODEL.json")
     r.add_argument("data", metavar="DATA")
-    r.add_argument("--out", required=True, metavar="FILE.csv")
+    r.add_argument("--out", required=True, metavar="FILE.csv",
+                   help="output table: .csv, .parquet, or - for CSV on standard output")
     r.add_argument("--mode", choices=["simulate", "one-step"], default="simulate", action=ModeAction,
                    help="free run (default) or one-step-ahead prediction")
     r.add_argument("--horizon", type=positive_int, default=None, metavar="K",

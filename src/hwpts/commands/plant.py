@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import sys
 
 import numpy as np
 
@@ -42,7 +43,7 @@ def register(subparsers) -> None:
         "and their average. Columns: valve_voltage_v, pump_speed_rpm, direction (up|down|average), "
         "motor_a_speed_rpm.",
     )
-    p.add_argument("--out", type=output_file, required=True, metavar="FILE.csv", help="output CSV")
+    p.add_argument("--out", type=output_file, required=True, metavar="FILE.csv", help="output table: .csv, .parquet, or - for CSV on standard output")
     p.add_argument("--voltages", type=grid, default=(1.2, 3.8, 27), metavar="START:STOP:N",
                    help="valve command grid [V] (default 1.2:3.8:27)")
     p.add_argument("--pump-speeds", type=grid, default=(200.0, 1000.0, 81), metavar="START:STOP:N",
@@ -59,7 +60,7 @@ def register(subparsers) -> None:
     source.add_argument("--case", choices=("case1", "case2", "case3", "case4"), help="one of the paper's validation cases")
     source.add_argument("--inputs", metavar="FILE.csv",
                         help="CSV with columns time_s, valve_voltage_v [V], pump_speed_rpm [r/min, the command]")
-    p.add_argument("--out", type=output_file, required=True, metavar="FILE.csv", help="output CSV")
+    p.add_argument("--out", type=output_file, required=True, metavar="FILE.csv", help="output table: .csv, .parquet, or - for CSV on standard output")
     p.add_argument("--noise-std", type=non_negative_float, default=None, metavar="RPM",
                    help="speed sensor noise standard deviation [r/min] (default: the test bed's 2.0)")
     p.add_argument("--seed", type=non_negative_int, default=0, metavar="N", help="noise seed (default 0)")
@@ -89,7 +90,7 @@ MAX_SWEEP_POINTS = 5_000_000  # operating points of one sweep (about 1.5 GiB of 
 def sweep_command(args) -> int:
     """``hwpts plant sweep``: up and down steady-state sweeps of the valve command (paper Fig. 3) to a CSV file."""
     from hwpts.experiments.sweeps import sweep_columns
-    from hwpts.io.datasets import write_csv
+    from hwpts.io.datasets import is_stdout, write_table
     from hwpts.plant import PlantParameters, sweep
 
     points = int(args.voltages[2]) * int(args.pump_speeds[2])
@@ -102,10 +103,11 @@ def sweep_command(args) -> int:
     voltages = np.linspace(*args.voltages)
     pumps = np.linspace(*args.pump_speeds)
     result = sweep(PlantParameters.paper(), voltages, pumps)
-    write_csv(args.out, sweep_columns(result))
+    write_table(args.out, sweep_columns(result))
     print(
         f"wrote {args.out}: {result.points_per_sweep} points per sweep (up, down, average); "
-        f"largest hysteresis gap {np.max(np.abs(result.gap_percent)):.1f} % of full scale"
+        f"largest hysteresis gap {np.max(np.abs(result.gap_percent)):.1f} % of full scale",
+        file=sys.stderr if is_stdout(args.out) else sys.stdout,
     )
     return 0
 
@@ -113,7 +115,7 @@ def sweep_command(args) -> int:
 def simulate_command(args) -> int:
     """``hwpts plant simulate``: a transient of the test bed (a validation case or the user's inputs) to a CSV file."""
     from hwpts.errors import DataError
-    from hwpts.io.datasets import read_table, write_csv
+    from hwpts.io.datasets import is_stdout, read_table, write_table
     from hwpts.plant import TestBed, validation_case
     from hwpts.plant.testbed import DEFAULT_NOISE_STD_RPM
 
@@ -133,6 +135,7 @@ def simulate_command(args) -> int:
                                  seed=args.seed)
         except DataError as error:
             raise DataError(f"--inputs {args.inputs!r}: {error}") from None
-    write_csv(args.out, dataset.columns())
-    print(f"wrote {args.out}: {dataset.n_samples} samples, {dataset.time[-1] - dataset.time[0]:.2f} s")
+    write_table(args.out, dataset.columns())
+    print(f"wrote {args.out}: {dataset.n_samples} samples, {dataset.time[-1] - dataset.time[0]:.2f} s",
+          file=sys.stderr if is_stdout(args.out) else sys.stdout)
     return 0

@@ -33,7 +33,7 @@ from hwpts.identification.partition import (
     drop_empty_regions,
     fit_linear_partition,
 )
-from hwpts.identification.regressors import RegressorStructure, validate_signals
+from hwpts.identification.regressors import RegressorStructure, dense_real, validate_signals
 from hwpts.identification.segmentation import make_segmenter
 from hwpts.identification.simulation import SimulationResult, k_step_pwarx, one_step_pwarx, simulate_pwarx
 from hwpts.identification.statespace import mode_state_space
@@ -358,7 +358,7 @@ class PWARX(BaseEstimator):
                 f"the measured output is needed (the first {self.structure_.max_lag} samples are "
                 f"the initial conditions)"
             )
-        u = np.asarray(X, dtype=float)
+        u = dense_real(X, "X")
         if u.ndim == 1:
             u = u[:, None]
         yy = None if y is None else _output_vector(y)
@@ -531,7 +531,10 @@ def _as_array(X):
 
 def _output_vector(y) -> np.ndarray:
     """The output as a 1-D array: shape (n,) or (n, 1) (a one-column DataFrame or Series too)."""
-    arr = np.asarray(_as_array(y))
+    arr = _as_array(y)
+    if hasattr(arr, "tocsr") or np.iscomplexobj(arr):
+        return dense_real(arr, "y")
+    arr = np.asarray(arr)
     if arr.ndim == 2 and arr.shape[1] == 1:
         arr = arr[:, 0]
     return arr

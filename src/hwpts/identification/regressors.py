@@ -217,12 +217,31 @@ class RegressorStructure:
                           d["input_names"], d["output_name"])
 
 
+MAX_ABS_VALUE = 1e100  # largest magnitude of a signal value: its square (and sums of them) stay finite
+
+
+def dense_real(values, label: str) -> np.ndarray:
+    """``values`` as a float array; sparse, complex or non-numeric input is refused (a cast would
+    drop the imaginary part or fail without saying which argument)."""
+    if hasattr(values, "tocsr") or hasattr(values, "toarray"):
+        raise DataError(f"{label} is a sparse matrix; pass a dense array ({label}.toarray())")
+    arr = np.asarray(values)
+    if np.iscomplexobj(arr):
+        raise DataError(f"{label} is complex; hwpts models real signals (pass the real part or the magnitude)")
+    if arr.dtype.kind not in "biuf":
+        try:
+            arr = arr.astype(float)
+        except (TypeError, ValueError):
+            raise DataError(f"{label} must hold numbers, got values of type {arr.dtype}") from None
+    return np.asarray(arr, dtype=float)
+
+
 def validate_signals(inputs, output, n_inputs: int | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Inputs as (n, p) float array and output as (n,) float array, finite, same length."""
-    u = np.asarray(inputs, dtype=float)
+    u = dense_real(inputs, "inputs")
     if u.ndim == 1:
         u = u[:, None]
-    y = np.asarray(output, dtype=float)
+    y = dense_real(output, "output")
     if u.ndim != 2:
         raise DataError(f"inputs must be 2-D (n_samples, n_inputs); got shape {u.shape}")
     if y.ndim != 1:
@@ -236,6 +255,11 @@ def validate_signals(inputs, output, n_inputs: int | None = None) -> tuple[np.nd
         if bad.any():
             row = int(np.argwhere(bad.reshape(arr.shape[0], -1))[0, 0])
             raise DataError(f"{label} has a non-finite value (NaN or inf) at row {row}")
+        huge = np.abs(arr) > MAX_ABS_VALUE
+        if huge.any():
+            row = int(np.argwhere(huge.reshape(arr.shape[0], -1))[0, 0])
+            raise DataError(f"{label} has the value {arr.reshape(arr.shape[0], -1)[row].max():.3g} at row {row}, beyond "
+                            f"+-{MAX_ABS_VALUE:.0e}: its squares overflow the least squares; rescale the signal")
     return u, y
 
 

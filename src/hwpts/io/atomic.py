@@ -49,6 +49,35 @@ def check_output_path(path: str | os.PathLike, what: str = "--out") -> Path:
     return target
 
 
+def process_alive(pid: int) -> bool:
+    """Whether a process ``pid`` exists (one we may not signal counts as alive)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:
+        return True
+    return True
+
+
+def _remove_stale_temporaries(target: Path, end: str) -> None:
+    """Temporary files of ``target`` left by a run that was killed (SIGKILL, power loss): their
+    name carries the writer's process id; those whose process is gone are removed."""
+    head = f".{target.name}."
+    for stale in target.parent.glob(f"{glob_escape(head)}*{glob_escape(end)}"):
+        pid_text = stale.name[len(head):].split(".", 1)[0]
+        if pid_text.isdigit() and int(pid_text) != os.getpid() and not process_alive(int(pid_text)):
+            with contextlib.suppress(OSError):
+                stale.unlink()
+
+
+def glob_escape(text: str) -> str:
+    """``text`` with the glob metacharacters escaped."""
+    import glob
+
+    return glob.escape(text)
+
+
 @contextlib.contextmanager
 def atomic_path(path: str | os.PathLike, suffix: str | None = None):
     """Yield a temporary path beside ``path``; on success rename it onto ``path``.
@@ -59,12 +88,11 @@ def atomic_path(path: str | os.PathLike, suffix: str | None = None):
     :class:`DataError` naming the path.
     """
     target = check_output_path(path)
+    end = suffix if suffix is not None else target.suffix + ".tmp"
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(
-            prefix=f".{target.name}.", suffix=suffix if suffix is not None else target.suffix + ".tmp",
-            dir=target.parent,
-        )
+        _remove_stale_temporaries(target, end)
+        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.{os.getpid()}.", suffix=end, dir=target.parent)
         os.close(fd)
     except OSError as error:
         raise DataError(f"--out {str(target)!r}: cannot write there ({error.strerror or error})") from None

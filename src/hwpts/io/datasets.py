@@ -35,12 +35,19 @@ def read_table(path: str | os.PathLike, columns=None) -> dict[str, np.ndarray]:
     if suffix == ".csv":
         return read_csv(p, columns)
     if suffix == ".parquet":
-        return _read_parquet(p)
-    if suffix == ".mat":
-        return _read_mat(p)
-    raise DataError(
-        f"{str(p)!r}: unsupported extension {p.suffix!r}; expected one of {list(SUPPORTED_SUFFIXES)}"
-    )
+        table = _read_parquet(p, columns)
+    elif suffix == ".mat":
+        table = _read_mat(p)
+    else:
+        raise DataError(
+            f"{str(p)!r}: unsupported extension {p.suffix!r}; expected one of {list(SUPPORTED_SUFFIXES)}"
+        )
+    wanted = [c for c in (columns if columns is not None else table) if c in table]
+    lengths = {c: int(np.asarray(table[c]).shape[0]) for c in wanted}
+    if len(set(lengths.values())) > 1:
+        raise DataError(f"{str(p)!r}: the variables differ in length ({', '.join(f'{k} {v}' for k, v in lengths.items())}); "
+                        f"every signal needs one value per sample")
+    return table
 
 
 DELIMITERS = (",", ";", "\t")
@@ -140,8 +147,8 @@ def _read_csv_python(p: Path, delimiter: str = ",", columns=None) -> dict[str, n
     return {header[j]: values[:, j].copy() for j in wanted}
 
 
-def write_csv(path: str | os.PathLike, columns: Mapping[str, np.ndarray], fmt: str = "%.10g") -> None:
-    """Write named columns of equal length to CSV, atomically. String columns are written as is."""
+def csv_text(columns: Mapping[str, np.ndarray], fmt: str = "%.10g") -> str:
+    """Named columns of equal length as CSV text (header row, comma-separated)."""
     names = list(columns)
     arrays = [np.asarray(columns[n]) for n in names]
     n = {a.shape[0] for a in arrays}
@@ -155,11 +162,28 @@ def write_csv(path: str | os.PathLike, columns: Mapping[str, np.ndarray], fmt: s
     if formatted:
         buf.write("\n".join(",".join(row) for row in zip(*formatted)))
         buf.write("\n")
-    write_text_atomic(path, buf.getvalue())
+    return buf.getvalue()
+
+
+def write_csv(path: str | os.PathLike, columns: Mapping[str, np.ndarray], fmt: str = "%.10g") -> None:
+    """Write named columns of equal length to CSV, atomically. String columns are written as is."""
+    write_text_atomic(path, csv_text(columns, fmt))
+
+
+def is_stdout(path) -> bool:
+    """Whether an output path is ``-`` (standard output)."""
+    return str(path) == "-"
 
 
 def write_table(path: str | os.PathLike, columns: Mapping[str, np.ndarray]) -> None:
-    """Write named numeric columns to ``.csv`` or ``.parquet`` (by extension), atomically."""
+    """Write named columns to ``.csv`` or ``.parquet`` (by extension), atomically; ``-`` writes CSV
+    to standard output."""
+    if is_stdout(path):
+        import sys
+
+        sys.stdout.write(csv_text(columns))
+        sys.stdout.flush()
+        return
     p = Path(path)
     if p.suffix.lower() == ".parquet":
         try:
@@ -174,7 +198,8 @@ def write_table(path: str | os.PathLike, columns: Mapping[str, np.ndarray]) -> N
     write_csv(p, columns)
 
 
-def _read_parquet(p: Path) -> dict[str, np.ndarray]:
+def _read_parquet(p: Path, columns=None) -> dict[str, np.ndarray]:
+    """Numeric columns of a Parquet file (only ``columns`` when given: the others may hold text)."""
     try:
         import pyarrow.parquet as pq
     except ImportError:  # pragma: no cover - pyarrow is a dependency
@@ -185,6 +210,8 @@ def _read_parquet(p: Path) -> dict[str, np.ndarray]:
         raise DataError(f"{str(p)!r}: not a readable Parquet file ({error})") from None
     out = {}
     for name in table.column_names:
+        if columns is not None and name not in columns:
+            continue
         col = table.column(name).to_numpy(zero_copy_only=False)
         try:
             out[name] = np.asarray(col, dtype=float)
@@ -205,7 +232,12 @@ def _read_mat(p: Path) -> dict[str, np.ndarray]:
     for name, value in raw.items():
         if name.startswith("__"):
             continue
+        if hasattr(value, "toarray") or hasattr(value, "tocsr"):
+            raise DataError(f"{str(p)!r}: variable {name!r} is a sparse matrix; save it as a full (dense) array")
         arr = np.asarray(value)
+        if arr.dtype.kind == "c":
+            raise DataError(f"{str(p)!r}: variable {name!r} is complex; hwpts models real signals "
+                            f"(save the real part, or the magnitude, as its own variable)")
         if arr.dtype.kind not in "biuf" or arr.size == 0:
             continue
         arr = arr.astype(float)

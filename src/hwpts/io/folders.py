@@ -38,13 +38,9 @@ PID_FILE = ".hwpts-pid"  # the process writing a staging folder
 
 
 def _alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except (PermissionError, OSError):
-        return True
-    return True
+    from hwpts.io.atomic import process_alive
+
+    return process_alive(pid)
 
 
 def _remove_stale_stages(out: Path) -> None:

@@ -132,10 +132,18 @@ def load_model(path: str | os.PathLike):
         raise DataError(f"model {str(p)!r}: not a UTF-8 JSON file") from None
     except ValueError as error:
         raise DataError(f"model {str(p)!r}: not a valid JSON model file ({error})") from None
+    except RecursionError:
+        raise DataError(f"model {str(p)!r}: JSON nested too deeply; not a model file") from None
+    except OSError as error:
+        raise DataError(f"model {str(p)!r}: cannot read it ({error.strerror or error})") from None
     try:
         return model_from_dict(doc)
     except HwptsError as error:
         raise DataError(f"model {str(p)!r}: {error}") from None
+    except (TypeError, ValueError, KeyError, AttributeError, IndexError, RecursionError) as error:
+        # a field of the wrong type that the checks below did not name: still one clear line
+        raise DataError(f"model {str(p)!r}: a field has the wrong type or shape ({type(error).__name__}: "
+                        f"{error}); refit the model with 'hwpts identify'") from None
 
 
 def _require(doc, key, kind, where):
@@ -155,6 +163,27 @@ def _numbers(value, shape_desc: str, where: str) -> np.ndarray:
     if not np.all(np.isfinite(arr)):
         raise DataError(f"{where} holds a non-finite number")
     return arr
+
+
+def _is_int(v) -> bool:
+    return isinstance(v, int) and not isinstance(v, bool)
+
+
+def _check_structure_types(st: dict) -> None:
+    """The structure's fields by type: orders ints (or lists of ints), names strings, constant bool."""
+    if not _is_int(st["na"]):
+        raise DataError(f"structure.na must be an int, got {type(st['na']).__name__}")
+    for key in ("nb", "nk"):
+        v = st[key]
+        if not (_is_int(v) or (isinstance(v, list) and v and all(_is_int(x) for x in v))):
+            raise DataError(f"structure.{key} must be an int or a list of ints, got {v!r}"[:200])
+    names = st["input_names"]
+    if not (isinstance(names, list) and names and all(isinstance(x, str) for x in names)):
+        raise DataError(f"structure.input_names must be a list of strings, got {type(names).__name__}")
+    if not isinstance(st["output_name"], str):
+        raise DataError(f"structure.output_name must be a string, got {type(st['output_name']).__name__}")
+    if not isinstance(st["constant"], bool):
+        raise DataError(f"structure.constant must be true or false, got {st['constant']!r}"[:200])
 
 
 def _signals_section(section, structure) -> tuple[float | None, dict]:
@@ -217,6 +246,7 @@ def model_from_dict(doc: dict):
     st_doc = _require(doc, "structure", dict, "the model")
     for key in ("na", "nb", "nk", "constant", "input_names", "output_name"):
         _require(st_doc, key, None, "structure")
+    _check_structure_types(st_doc)
     try:
         structure = RegressorStructure.from_dict(st_doc)
     except HwptsError as error:

@@ -15,6 +15,26 @@ import numpy as np
 
 from hwpts.errors import ParameterError
 
+# Physical ranges of the test bed's inputs, checked wherever the plant takes them: the valve
+# amplifier's command range (the spool saturates outside 1.2-3.5 V, docs/plant.md section 4) and
+# the prime mover's speed range (the paper operates at 200-1000 r/min).
+VALVE_VOLTAGE_RANGE_V = (0.0, 10.0)
+PUMP_SPEED_RANGE_RPM = (0.0, 3000.0)
+
+
+def check_input_ranges(valve_voltage, pump_speed_rpm, error=ParameterError, where: str = "") -> None:
+    """Refuse valve commands [V] or pump speeds [r/min] that are not finite or lie outside the
+    test bed's physical ranges (:data:`VALVE_VOLTAGE_RANGE_V`, :data:`PUMP_SPEED_RANGE_RPM`)."""
+    for label, unit, values, (lo, hi) in (("valve voltage", "V", valve_voltage, VALVE_VOLTAGE_RANGE_V),
+                                          ("pump speed", "r/min", pump_speed_rpm, PUMP_SPEED_RANGE_RPM)):
+        a = np.asarray(values, dtype=float)
+        bad = ~np.isfinite(a) | (a < lo) | (a > hi)
+        if np.any(bad):
+            first = a[bad].ravel()[0]
+            raise error(f"{where}{label} must be a finite number in {lo:g}-{hi:g} {unit} (the test bed's range), "
+                        f"got {first!r}")
+
+
 DROOP_TEST_BED = 3.37
 """Prime-mover droop K_droop of the lab rig [(rad/s)/(N m)] (docs/plant.md section 5, tuned on the triangle test)."""
 

@@ -285,8 +285,9 @@ def simulate_plant(
         raise DataError(f"time must be strictly increasing; it is not at row {int(np.argmax(~(np.diff(t) > 0))) + 1}")
     v = _as_signal("valve voltage", valve_voltage, n)
     w_rpm = _as_signal("pump speed", pump_speed, n)
-    if np.any(w_rpm < 0):
-        raise DataError(f"pump speed must be >= 0 r/min; row {int(np.argmax(w_rpm < 0))} has {w_rpm[w_rpm < 0][0]}")
+    from hwpts.plant.parameters import check_input_ranges
+
+    check_input_ranges(v, w_rpm, error=DataError)
     v_eff = play_operator(v, parameters.hysteresis_half_width, valve_initial)
     h_cmd = np.ascontiguousarray(spool_position(v_eff, parameters))
     wp_cmd = w_rpm * RAD_S_PER_RPM

@@ -258,14 +258,11 @@ class SteadyState:
 
 
 def _check_operating_points(valve_voltage, pump_speed_rpm):
+    from hwpts.plant.parameters import check_input_ranges
+
     v = np.asarray(valve_voltage, dtype=float)
     w = np.asarray(pump_speed_rpm, dtype=float)
-    if not np.all(np.isfinite(v)):
-        raise ParameterError(f"valve voltage must be a finite number [V], got {v[~np.isfinite(v)].ravel()[0]!r}")
-    if not np.all(np.isfinite(w)):
-        raise ParameterError(f"pump speed must be a finite number [r/min], got {w[~np.isfinite(w)].ravel()[0]!r}")
-    if np.any(w < 0):
-        raise ParameterError(f"pump speed must be >= 0 r/min, got {w[w < 0].ravel()[0]!r}")
+    check_input_ranges(v, w)
     return np.broadcast_arrays(v, w)
 
 

@@ -1,0 +1,295 @@
+"""Bad and unusual input through every command (issue 10): exit status 2, exactly one line
+``hwpts: ...`` naming the argument or file, no traceback, no output created or changed, inputs
+unchanged. Each case runs the command line in-process on a workspace of valid files (data, a model,
+plant inputs) and of broken ones; the whole workspace is compared byte for byte before and after.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.io import savemat
+
+from hwpts.cli import main
+from hwpts.identification.synthetic import make_system
+from hwpts.io.datasets import write_csv
+from hwpts.io.models import checksum
+
+FIT = ["--input", "u1", "--input", "u2", "--output", "y"]
+FIXED = [*FIT, "--na", "2", "--nb", "2", "--segmentation", "average"]
+
+
+def _edited_model(doc: dict, edit) -> str:
+    """A model document edited by ``edit`` with its checksum recomputed (structurally wrong, yet
+    not caught by the checksum)."""
+    doc = json.loads(json.dumps(doc))
+    edit(doc)
+    sections = doc["checksum"]["sections"]
+    doc["checksum"]["value"] = checksum(doc, sections)
+    return json.dumps(doc)
+
+
+@pytest.fixture(scope="module")
+def workspace(tmp_path_factory):
+    ws = tmp_path_factory.mktemp("bad_input")
+    d = make_system(5, rng=0, n=400)
+    t = np.arange(400) * 0.01
+    write_csv(ws / "data.csv", {"time_s": t, "u1": d.inputs[:, 0], "u2": d.inputs[:, 1], "y": d.output})
+    write_csv(ws / "fast.csv", {"time_s": t / 10, "u1": d.inputs[:, 0], "u2": d.inputs[:, 1], "y": d.output})
+    write_csv(ws / "notime.csv", {"u1": d.inputs[:, 0], "u2": d.inputs[:, 1], "y": d.output})
+    write_csv(ws / "short.csv", {"time_s": t[:6], "u1": d.inputs[:6, 0], "u2": d.inputs[:6, 1], "y": d.output[:6]})
+    assert main(["identify", str(ws / "data.csv"), *FIXED, "--out", str(ws / "model.json")]) == 0
+    doc = json.loads((ws / "model.json").read_text())
+    files = {
+        "empty.csv": "",
+        "header.csv": "time_s,u1,u2,y\n",
+        "text.csv": "time_s,u1,u2,y\n0,1,2,3\n0.01,1,abc,3\n",
+        "nan.csv": "u1,u2,y\n" + "".join(f"{i},{i % 3},{'nan' if i == 7 else i}\n" for i in range(40)),
+        "inf.csv": "u1,u2,y\n" + "".join(f"{i},{i % 3},{'inf' if i == 7 else i}\n" for i in range(40)),
+        "huge.csv": "u1,u2,y\n" + "".join(f"{i},{i % 3},{'1e308' if i == 7 else i}\n" for i in range(40)),
+        "ragged.csv": "u1,u2,y\n1,2,3\n4,5\n6,7,8\n",
+        "dupe.csv": "u1,u1,y\n1,2,3\n4,5,6\n",
+        "onecol.csv": "y\n1\n2\n3\n",
+        "backwards.csv": "time_s,u1,u2,y\n" + "".join(f"{(5 - i) * 0.1},{i},{i % 3},{i}\n" for i in range(6)),
+        "constant.csv": "u1,u2,y\n" + "".join(f"1,{i % 3},{i * i % 7}\n" for i in range(60)),
+        "data.txt": "u1,u2,y\n1,2,3\n",
+        "garbage.csv": None,
+        "latin1.csv": None,
+        "corrupt.parquet": "PAR1 this is not parquet",
+        "notjson.json": "this is not JSON",
+        "truncated.json": (ws / "model.json").read_text()[:200],
+        "schema.json": json.dumps({"schema": "something/else"}),
+        "tampered.json": (ws / "model.json").read_text().replace('"theta": [', '"theta": [1.5e-3, ', 1),
+        "nested.json": "[" * 100000 + "]" * 100000,
+        "nonfinite.json": (ws / "model.json").read_text().replace('"constant": true', '"constant": NaN', 1),
+        "array.json": "[1, 2, 3]",
+        "types.json": _edited_model(doc, lambda m: m["regions"][0].__setitem__("theta", ["a", "b"])),
+        "names.json": _edited_model(doc, lambda m: m["structure"].__setitem__("input_names", 5)),
+        "orders.json": _edited_model(doc, lambda m: m["structure"].__setitem__("na", "two")),
+        "polyhedra.json": _edited_model(doc, lambda m: m["partition"].__setitem__("polyhedra", {"H": 1})),
+        "dt.json": _edited_model(doc, lambda m: m["signals"].__setitem__("sample_time_s", -1)),
+        "units.json": _edited_model(doc, lambda m: m["signals"].__setitem__("units", [1, 2])),
+        "cov.json": _edited_model(doc, lambda m: m["regions"][0].__setitem__("theta_covariance", [[1]])),
+        "inputs.csv": "time_s,valve_voltage_v,pump_speed_rpm\n0,2.4,700\n0.5,2.4,700\n1.0,2.5,700\n",
+        "inputs_missing.csv": "time_s,valve_voltage_v\n0,2.4\n1,2.4\n",
+        "inputs_huge.csv": "time_s,valve_voltage_v,pump_speed_rpm\n0,1e308,700\n1,2.4,700\n",
+        "inputs_back.csv": "time_s,valve_voltage_v,pump_speed_rpm\n1,2.4,700\n0,2.4,700\n",
+        "inputs_rpm.csv": "time_s,valve_voltage_v,pump_speed_rpm\n0,2.4,1e9\n1,2.4,700\n",
+        "afile": "x",
+    }
+    for name, text in files.items():
+        if text is not None:
+            (ws / name).write_text(text)
+    (ws / "garbage.csv").write_bytes(bytes(range(256)) * 8)
+    (ws / "latin1.csv").write_bytes("u1,u2,y\n1,2,3\n\xe9,\xe8,\xe0\n".encode("latin-1"))
+    savemat(ws / "ragged.mat", {"u1": np.arange(10.0), "u2": np.arange(10.0), "y": np.arange(12.0)})
+    savemat(ws / "good.mat", {"u1": d.inputs[:, 0], "u2": d.inputs[:, 1], "y": d.output})
+    (ws / "folder").mkdir()
+    (ws / "link.json").symlink_to(ws / "afile")
+    foreign = ws / "foreign"
+    foreign.mkdir()
+    (foreign / "thesis.tex").write_text("precious")
+    return ws
+
+
+def _snapshot(root: Path) -> dict:
+    out = {}
+    for path in sorted(root.rglob("*")):
+        rel = str(path.relative_to(root))
+        if path.is_symlink():
+            out[rel] = ("link", os.readlink(path))
+        elif path.is_file():
+            out[rel] = ("file", path.read_bytes())
+        else:
+            out[rel] = ("dir", None)
+    return out
+
+
+W = "{ws}"  # replaced by the workspace folder
+CASES = [
+    # --- the parser
+    ([], "COMMAND"),
+    (["fly"], "invalid choice: 'fly'"),
+    (["identify"], "DATA"),
+    # --- identify: the data file
+    (["identify", f"{W}/missing.csv", *FIXED, "--out", f"{W}/m.json"], "missing.csv"),
+    (["identify", f"{W}/folder", *FIXED, "--out", f"{W}/m.json"], "folder"),
+    (["identify", f"{W}/empty.csv", *FIXED, "--out", f"{W}/m.json"], "empty.csv"),
+    (["identify", f"{W}/header.csv", *FIXED, "--out", f"{W}/m.json"], "header.csv"),
+    (["identify", f"{W}/text.csv", *FIXED, "--out", f"{W}/m.json"], "text.csv"),
+    (["identify", f"{W}/nan.csv", *FIXED, "--out", f"{W}/m.json"], "nan.csv"),
+    (["identify", f"{W}/inf.csv", *FIXED, "--out", f"{W}/m.json"], "inf.csv"),
+    (["identify", f"{W}/huge.csv", *FIXED, "--out", f"{W}/m.json"], "huge.csv"),
+    (["identify", f"{W}/ragged.csv", *FIXED, "--out", f"{W}/m.json"], "ragged.csv"),
+    (["identify", f"{W}/dupe.csv", "--input", "u1", "--output", "y", "--na", "1", "--nb", "1", "--out", f"{W}/m.json"], "dupe.csv"),
+    (["identify", f"{W}/onecol.csv", *FIXED, "--out", f"{W}/m.json"], "onecol.csv"),
+    (["identify", f"{W}/backwards.csv", *FIXED, "--out", f"{W}/m.json"], "time"),
+    (["identify", f"{W}/constant.csv", *FIXED, "--out", f"{W}/m.json"], "'u1' is constant"),
+    (["identify", f"{W}/data.txt", *FIXED, "--out", f"{W}/m.json"], "data.txt"),
+    (["identify", f"{W}/garbage.csv", *FIXED, "--out", f"{W}/m.json"], "garbage.csv"),
+    (["identify", f"{W}/latin1.csv", *FIXED, "--out", f"{W}/m.json"], "latin1.csv"),
+    (["identify", f"{W}/corrupt.parquet", *FIXED, "--out", f"{W}/m.json"], "corrupt.parquet"),
+    (["identify", f"{W}/ragged.mat", *FIXED, "--out", f"{W}/m.json"], "ragged.mat"),
+    (["identify", f"{W}/short.csv", *FIXED, "--out", f"{W}/m.json"], "short.csv"),
+    (["identify", f"{W}/data.csv", "--input", "u9", "--output", "y", "--na", "1", "--nb", "1", "--out", f"{W}/m.json"], "u9"),
+    (["identify", f"{W}/data.csv", "--input", "u1", "--output", "zz", "--na", "1", "--nb", "1", "--out", f"{W}/m.json"], "zz"),
+    (["identify", f"{W}/data.csv", "--input", "u1", "--na", "1", "--out", f"{W}/m.json"], "--output"),
+    (["identify", f"{W}/data.csv", *FIT, "--na", "1", "--nb", "1"], "--out"),
+    # --- identify: the options
+    (["identify", f"{W}/data.csv", *FIT, "--na", "-1", "--nb", "2", "--out", f"{W}/m.json"], "--na"),
+    (["identify", f"{W}/data.csv", *FIT, "--na", "two", "--nb", "2", "--out", f"{W}/m.json"], "--na"),
+    (["identify", f"{W}/data.csv", *FIT, "--na", "2", "--nb", "1,2,3", "--out", f"{W}/m.json"], "nb"),
+    (["identify", f"{W}/data.csv", *FIT, "--na", "2", "--nb", "x", "--out", f"{W}/m.json"], "--nb"),
+    (["identify", f"{W}/data.csv", *FIT, "--na", "2", "--nb", "2", "--nk", "-1", "--out", f"{W}/m.json"], "--nk"),
+    (["identify", f"{W}/data.csv", *FIT, "--na", "2", "--nb", "2", "--regions", "0", "--out", f"{W}/m.json"], "--regions"),
+    (["identify", f"{W}/data.csv", *FIT, "--na", "2", "--nb", "2", "--regions", "many", "--out", f"{W}/m.json"], "--regions"),
+    (["identify", f"{W}/data.csv", *FIT, "--na", "2", "--nb", "2", "--segmentation", "kmeans", "--regions", "80",
+      "--out", f"{W}/m.json"], "n_regions=80"),
+    (["identify", f"{W}/data.csv", *FIT, "--segmentation", "bogus", "--out", f"{W}/m.json"], "--segmentation"),
+    (["identify", f"{W}/data.csv", *FIT, "--na", "2", "--nb", "2", "--hyperplane", "a,b,c", "--out", f"{W}/m.json"], "hyperplane"),
+    (["identify", f"{W}/data.csv", *FIT, "--na", "2", "--nb", "2", "--segmentation", "hyperplane", "--out", f"{W}/m.json"], "--hyperplane"),
+    (["identify", f"{W}/data.csv", *FIT, "--na", "2", "--nb", "2", "--segmentation", "kmeans", "--hyperplane", "1,0,0",
+      "--out", f"{W}/m.json"], "--hyperplane"),
+    (["identify", f"{W}/data.csv", *FIT, "--na", "2", "--nb", "2", "--segmentation", "kmeans", "--regions", "2",
+      "--zero-region", "9", "--out", f"{W}/m.json"], "--zero-region"),
+    (["identify", f"{W}/data.csv", *FIXED, "--ridge", "-1", "--out", f"{W}/m.json"], "--ridge"),
+    (["identify", f"{W}/data.csv", *FIXED, "--ridge", "inf", "--out", f"{W}/m.json"], "--ridge"),
+    (["identify", f"{W}/data.csv", *FIXED, "--seed", "-1", "--out", f"{W}/m.json"], "--seed"),
+    (["identify", f"{W}/data.csv", *FIXED, "--seed", "1.5", "--out", f"{W}/m.json"], "--seed"),
+    (["identify", f"{W}/data.csv", *FIXED, "--rows", "5:abc", "--out", f"{W}/m.json"], "--rows"),
+    (["identify", f"{W}/data.csv", *FIXED, "--rows", "300:100", "--out", f"{W}/m.json"], "--rows"),
+    (["identify", f"{W}/data.csv", *FIXED, "--time", "clock", "--out", f"{W}/m.json"], "clock"),
+    (["identify", f"{W}/data.csv", *FIXED, "--partition-column", "bogus(k-1)", "--out", f"{W}/m.json"], "bogus(k-1)"),
+    (["identify", f"{W}/data.csv", *FIXED, "--unit", "mm", "--out", f"{W}/m.json"], "--unit"),
+    (["identify", f"{W}/data.csv", *FIXED, "--unit", "q=mm", "--out", f"{W}/m.json"], "--unit"),
+    # --- identify: the output path
+    (["identify", f"{W}/data.csv", *FIXED, "--out", f"{W}/folder"], "folder"),
+    (["identify", f"{W}/data.csv", *FIXED, "--out", f"{W}/afile/m.json"], "afile"),
+    (["identify", f"{W}/data.csv", *FIXED, "--out", f"{W}/link.json"], "link.json"),
+    (["identify", f"{W}/data.csv", *FIXED, "--out", f"{W}/data.csv"], "data.csv"),
+    (["identify", f"{W}/data.csv", *FIXED, "--out", "/dev/null"], "/dev/null"),
+    # --- validate: the model file
+    (["validate", f"{W}/missing.json", f"{W}/data.csv"], "missing.json"),
+    (["validate", f"{W}/folder", f"{W}/data.csv"], "folder"),
+    (["validate", f"{W}/notjson.json", f"{W}/data.csv"], "notjson.json"),
+    (["validate", f"{W}/truncated.json", f"{W}/data.csv"], "truncated.json"),
+    (["validate", f"{W}/schema.json", f"{W}/data.csv"], "schema.json"),
+    (["validate", f"{W}/tampered.json", f"{W}/data.csv"], "checksum"),
+    (["validate", f"{W}/nested.json", f"{W}/data.csv"], "nested.json"),
+    (["validate", f"{W}/nonfinite.json", f"{W}/data.csv"], "nonfinite.json"),
+    (["validate", f"{W}/array.json", f"{W}/data.csv"], "array.json"),
+    (["validate", f"{W}/types.json", f"{W}/data.csv"], "types.json"),
+    (["validate", f"{W}/names.json", f"{W}/data.csv"], "names.json"),
+    (["validate", f"{W}/orders.json", f"{W}/data.csv"], "orders.json"),
+    (["validate", f"{W}/polyhedra.json", f"{W}/data.csv"], "polyhedra.json"),
+    (["validate", f"{W}/dt.json", f"{W}/data.csv"], "dt.json"),
+    (["validate", f"{W}/units.json", f"{W}/data.csv"], "units.json"),
+    (["validate", f"{W}/cov.json", f"{W}/data.csv"], "cov.json"),
+    (["validate", f"{W}/garbage.csv", f"{W}/data.csv"], "garbage.csv"),
+    # --- validate: the data
+    (["validate", f"{W}/model.json", f"{W}/missing.csv"], "missing.csv"),
+    (["validate", f"{W}/model.json", f"{W}/onecol.csv"], "onecol.csv"),
+    (["validate", f"{W}/model.json", f"{W}/fast.csv"], "sample time"),
+    (["validate", f"{W}/model.json", f"{W}/notime.csv", "--resample"], "--resample"),
+    (["validate", f"{W}/model.json", f"{W}/short.csv"], "short.csv"),
+    (["validate", f"{W}/model.json", f"{W}/data.csv", "--input", "u1"], "--input"),
+    (["validate", f"{W}/model.json", f"{W}/data.csv", "--output", "q"], "q"),
+    (["validate", f"{W}/model.json", f"{W}/data.csv", "--plot", f"{W}/v.jpg"], "--plot"),
+    (["validate", f"{W}/model.json", f"{W}/data.csv", "--plot", f"{W}/folder/"], "--plot"),
+    (["validate", f"{W}/model.json", f"{W}/data.csv", "--rows", "1:2:3"], "--rows"),
+    (["validate", f"{W}/model.json", f"{W}/good.mat", "--time", "t"], "good.mat"),
+    # --- predict
+    (["predict", f"{W}/model.json", f"{W}/data.csv", "--out", f"{W}/model.json"], "model"),
+    (["predict", f"{W}/model.json", f"{W}/data.csv", "--out", f"{W}/data.csv"], "data"),
+    (["predict", f"{W}/model.json", f"{W}/data.csv", "--out", f"{W}/folder"], "folder"),
+    (["predict", f"{W}/model.json", f"{W}/data.csv", "--out", f"{W}/p.csv", "--horizon", "0"], "--horizon"),
+    (["predict", f"{W}/model.json", f"{W}/data.csv", "--out", f"{W}/p.csv", "--horizon", "ten"], "--horizon"),
+    (["predict", f"{W}/model.json", f"{W}/data.csv", "--out", f"{W}/p.csv", "--horizon", "3", "--mode", "one-step"], "--horizon"),
+    (["predict", f"{W}/model.json", f"{W}/data.csv", "--out", f"{W}/p.csv", "--mode", "fast"], "--mode"),
+    (["predict", f"{W}/model.json", f"{W}/fast.csv", "--out", f"{W}/p.csv"], "sample time"),
+    (["predict", f"{W}/tampered.json", f"{W}/data.csv", "--out", f"{W}/p.csv"], "tampered.json"),
+    # --- residuals
+    (["residuals", f"{W}/model.json", f"{W}/data.csv", "--lags", "0"], "--lags"),
+    (["residuals", f"{W}/model.json", f"{W}/data.csv", "--lags", "100000"], "lags"),
+    (["residuals", f"{W}/model.json", f"{W}/data.csv", "--confidence", "1.5"], "--confidence"),
+    (["residuals", f"{W}/model.json", f"{W}/data.csv", "--confidence", "high"], "--confidence"),
+    (["residuals", f"{W}/missing.json", f"{W}/data.csv"], "missing.json"),
+    (["residuals", f"{W}/model.json", f"{W}/data.csv", "--plot", f"{W}/data.csv.png", "--input", "a"], "--input"),
+    # --- export
+    (["export", f"{W}/model.json", "--format", "excel", "--out", f"{W}/x.xls"], "--format"),
+    (["export", f"{W}/model.json", "--format", "matlab", "--out", f"{W}/x.json"], "--out"),
+    (["export", f"{W}/model.json", "--format", "json", "--out", f"{W}/model.json"], "model"),
+    (["export", f"{W}/missing.json", "--format", "json", "--out", f"{W}/x.json"], "missing.json"),
+    (["export", f"{W}/model.json", "--format", "json"], "--out"),
+    # --- plant steady-state
+    (["plant", "steady-state", "--valve-voltage", "abc", "--pump-speed", "700"], "--valve-voltage"),
+    (["plant", "steady-state", "--valve-voltage", "nan", "--pump-speed", "700"], "--valve-voltage"),
+    (["plant", "steady-state", "--valve-voltage", "1e308", "--pump-speed", "700"], "valve"),
+    (["plant", "steady-state", "--valve-voltage", "2.4", "--pump-speed", "-5"], "pump"),
+    (["plant", "steady-state", "--valve-voltage", "2.4", "--pump-speed", "1e9"], "pump"),
+    (["plant", "steady-state", "--valve-voltage", "2.4", "--pump-speed", "700", "--branch", "left"], "--branch"),
+    (["plant", "steady-state", "--valve-voltage", "2.4"], "--pump-speed"),
+    # --- plant sweep
+    (["plant", "sweep", "--out", f"{W}/s.csv", "--voltages", "3:1:5"], "--voltages"),
+    (["plant", "sweep", "--out", f"{W}/s.csv", "--voltages", "1:2"], "--voltages"),
+    (["plant", "sweep", "--out", f"{W}/s.csv", "--pump-speeds", "200:1000:0"], "--pump-speeds"),
+    (["plant", "sweep", "--out", f"{W}/s.csv", "--voltages", "1.2:3.8:50000", "--pump-speeds", "200:1000:50000"], "--voltages x --pump-speeds"),
+    (["plant", "sweep", "--out", f"{W}/s.csv", "--voltages", "0:100:5"], "volt"),
+    (["plant", "sweep", "--out", f"{W}/folder"], "folder"),
+    (["plant", "sweep", "--out", f"{W}/link.json"], "link.json"),
+    # --- plant simulate
+    (["plant", "simulate", "--case", "case9", "--out", f"{W}/sim.csv"], "--case"),
+    (["plant", "simulate", "--out", f"{W}/sim.csv"], "--case"),
+    (["plant", "simulate", "--case", "case1", "--inputs", f"{W}/inputs.csv", "--out", f"{W}/sim.csv"], "--inputs"),
+    (["plant", "simulate", "--inputs", f"{W}/missing.csv", "--out", f"{W}/sim.csv"], "missing.csv"),
+    (["plant", "simulate", "--inputs", f"{W}/inputs_missing.csv", "--out", f"{W}/sim.csv"], "pump_speed_rpm"),
+    (["plant", "simulate", "--inputs", f"{W}/inputs_huge.csv", "--out", f"{W}/sim.csv"], "valve"),
+    (["plant", "simulate", "--inputs", f"{W}/inputs_rpm.csv", "--out", f"{W}/sim.csv"], "pump"),
+    (["plant", "simulate", "--inputs", f"{W}/inputs_back.csv", "--out", f"{W}/sim.csv"], "time"),
+    (["plant", "simulate", "--inputs", f"{W}/inputs.csv", "--out", f"{W}/inputs.csv"], "inputs"),
+    (["plant", "simulate", "--case", "case1", "--noise-std", "-1", "--out", f"{W}/sim.csv"], "--noise-std"),
+    (["plant", "simulate", "--case", "case1", "--seed", "-3", "--out", f"{W}/sim.csv"], "--seed"),
+    # --- reproduce
+    (["reproduce", "--quick", "--out", f"{W}/afile"], "afile"),
+    (["reproduce", "--quick", "--out", f"{W}/foreign"], "foreign"),
+    (["reproduce", "--seed", "abc", "--out", f"{W}/r"], "--seed"),
+    # --- control
+    (["control", "run", "--scenario", "hurricane", "--model", f"{W}/model.json", "--out", f"{W}/c"], "--scenario"),
+    (["control", "run", "--scenario", "pump-step", "--model", f"{W}/missing.json", "--out", f"{W}/c"], "missing.json"),
+    (["control", "run", "--scenario", "pump-step", "--model", f"{W}/model.json", "--out", f"{W}/c"], "valve"),
+    (["control", "run", "--scenario", "pump-step", "--controllers", "magic", "--out", f"{W}/c"], "magic"),
+    (["control", "run", "--scenario", "pump-step", "--setpoint", "1e9", "--out", f"{W}/c"], "--setpoint"),
+    (["control", "run", "--scenario", "pump-step", "--duration", "-1", "--out", f"{W}/c"], "--duration"),
+    (["control", "run", "--scenario", "pump-step", "--seed", "x", "--out", f"{W}/c"], "--seed"),
+    (["control", "study", "--plants", "0", "--seeds", "1", "--out", f"{W}/st"], "--plants"),
+    (["control", "study", "--plants", "2", "--seeds", "-1", "--out", f"{W}/st"], "--seeds"),
+]
+
+
+@pytest.mark.parametrize("argv, needle", CASES, ids=[" ".join(a)[:70] or "(none)" for a, _ in CASES])
+def test_bad_input_is_one_line_and_changes_nothing(workspace, capsys, argv, needle):
+    argv = [a.replace(W, str(workspace)) for a in argv]
+    before = _snapshot(workspace)
+    capsys.readouterr()
+    try:
+        status = main(argv)
+    except SystemExit as stop:  # argparse's --help/--version only; never for bad input
+        status = stop.code
+    out, err = capsys.readouterr()
+    lines = err.strip().splitlines()
+    assert status == 2, f"exit {status}; stderr: {err!r}; stdout: {out[:300]!r}"
+    assert len(lines) == 1 and lines[0].startswith("hwpts: "), err
+    assert "Traceback" not in err + out
+    assert needle in lines[0], f"{needle!r} not named in {lines[0]!r}"
+    assert _snapshot(workspace) == before, "a file was created or changed"
+
+
+def test_the_suite_is_large_enough():
+    assert len(CASES) >= 100
+    commands = {a[0] if a and a[0] not in ("plant", "control") else " ".join(a[:2]) for a, _ in CASES if a}
+    assert {"identify", "validate", "predict", "residuals", "export", "reproduce", "plant steady-state",
+            "plant sweep", "plant simulate", "control run", "control study"} <= commands
