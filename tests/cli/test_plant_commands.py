@@ -79,7 +79,7 @@ def test_sweep_writes_up_down_average(tmp_path, capsys):
         (["--voltages", "3.8:1.2:27"], ["--voltages", "reversed grid", "3.8:1.2:27"]),
         (["--voltages", "1.2:3.8:0"], ["--voltages", "empty grid"]),
         (["--pump-speeds", "200:1000"], ["--pump-speeds", "START:STOP:N"]),
-        (["--pump-speeds=-200:1000:5"], ["pump speed must be >= 0"]),
+        (["--pump-speeds=-200:1000:5"], ["pump speed must be a finite number in 0-3000 r/min"]),
         (["--voltages", "1.2:nan:5"], ["--voltages", "finite"]),
         (["--voltages", "1.2:3.8:x"], ["--voltages", "whole number"]),
     ],

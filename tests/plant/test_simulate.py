@@ -78,7 +78,7 @@ def test_solver_failure_raises_simulation_error():
         ([0.0, 0.1, 0.1], 2.0, 500.0, "strictly increasing"),
         ([0.0, np.nan], 2.0, 500.0, "time has a non-finite"),
         ([0.0, 0.1], [2.0, np.nan], 500.0, "valve voltage has a non-finite"),
-        ([0.0, 0.1], 2.0, [500.0, -1.0], "pump speed must be >= 0"),
+        ([0.0, 0.1], 2.0, [500.0, -1.0], "pump speed must be a finite number in 0-3000 r/min"),
         ([], 2.0, 500.0, "time is empty"),
     ],
 )

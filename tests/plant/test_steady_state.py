@@ -56,7 +56,7 @@ def test_branches_bracket_the_averaged_valve():
     [
         ({"valve_voltage": np.nan, "pump_speed_rpm": 500}, "valve voltage must be a finite number"),
         ({"valve_voltage": 2.0, "pump_speed_rpm": np.inf}, "pump speed must be a finite number"),
-        ({"valve_voltage": 2.0, "pump_speed_rpm": -5.0}, "pump speed must be >= 0"),
+        ({"valve_voltage": 2.0, "pump_speed_rpm": -5.0}, "pump speed must be a finite number in 0-3000 r/min"),
         ({"valve_voltage": 2.0, "pump_speed_rpm": 500, "branch": "sideways"}, "branch must be one of"),
     ],
 )

@@ -86,7 +86,10 @@ def read_csv(path: str | os.PathLike, columns=None) -> dict[str, np.ndarray]:
         return _read_csv_python(p, delimiter, columns)  # raises the precise error
     except OSError as error:
         raise DataError(f"{str(p)!r}: cannot read ({error.strerror or error})") from None
-    names = [str(n).strip() for n in table.column_names]
+    try:
+        names = [str(n).strip() for n in table.column_names]
+    except UnicodeDecodeError:  # a header that is not UTF-8
+        return _read_csv_python(p, delimiter, columns)  # raises the precise error
     # an unnamed column with no value (a trailing delimiter on every row) is not a column
     keep = [i for i, n in enumerate(names) if n or table.column(i).null_count < table.num_rows]
     if any(not names[i] for i in keep) or len({names[i] for i in keep}) != len(keep):

@@ -32,7 +32,7 @@ def check_input_ranges(valve_voltage, pump_speed_rpm, error=ParameterError, wher
         if np.any(bad):
             first = a[bad].ravel()[0]
             raise error(f"{where}{label} must be a finite number in {lo:g}-{hi:g} {unit} (the test bed's range), "
-                        f"got {first!r}")
+                        f"got {float(first):g}")
 
 
 DROOP_TEST_BED = 3.37
