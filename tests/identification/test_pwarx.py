@@ -258,3 +258,15 @@ def test_complex_and_sparse_input_are_refused():
         model.predict(d.inputs * (1 + 0j), d.output)
     with pytest.raises(DataError, match="must hold numbers"):
         model.predict(np.array([["a", "b"]] * 300), d.output)
+
+
+def test_a_dataset_at_another_sample_time_is_refused():
+    d = make_system(5, rng=0, n=400)
+    t = np.arange(400) * 0.01
+    train = IODataset(t, d.inputs, d.output, ("u1", "u2"), "y")
+    model = PWARX(2, 2, 1, n_regions=1, segmentation="average").fit(train)
+    assert model.sample_time_ == pytest.approx(0.01)
+    np.testing.assert_array_equal(model.predict(train), model.predict(d.inputs, d.output))
+    fast = IODataset(t / 4, d.inputs, d.output, ("u1", "u2"), "y")
+    with pytest.raises(DataError, match="sample time 0.0025 s differs from the model's 0.01 s"):
+        model.simulate(fast)

@@ -347,6 +347,10 @@ class PWARX(BaseEstimator):
         if isinstance(X, IODataset):
             if y is not None:
                 raise ParameterError("pass either an IODataset or (inputs, output), not both")
+            known = getattr(self, "sample_time_", None)
+            if known is not None and X.n_samples > 1 and abs(X.sample_time - known) > 0.01 * known:
+                raise DataError(f"the data's sample time {X.sample_time:.6g} s differs from the model's {known:.6g} s: "
+                                f"its lags would mean other delays; resample the data or refit")
             X, y = _select_columns(X.inputs, X.input_names, self.input_names_), X.output
         else:
             frame_names = _column_names(X)
