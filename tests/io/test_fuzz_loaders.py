@@ -161,3 +161,21 @@ def test_structurally_edited_model_files(model_doc, data):
             load_model(file)
         except HwptsError:
             pass
+
+
+def test_a_mat_file_that_crashes_scipys_reader_is_one_error(tmp_path):
+    """scipy's compiled reader can die (segmentation fault) on a corrupt element type; the file is
+    read in a child process, so hwpts says the file is corrupt instead of dying (found by the fuzzing
+    of a parallel branch of this work)."""
+    import io
+
+    from scipy.io import savemat
+
+    buf = io.BytesIO()
+    savemat(buf, {"a": np.arange(5.0), "y": np.ones((3, 2))})
+    data = bytearray(buf.getvalue())
+    data[273] = 62  # the type of y's data element: 9 (double) becomes 15881
+    path = tmp_path / "crash.mat"
+    path.write_bytes(bytes(data))
+    with pytest.raises(HwptsError, match="not a readable MATLAB .mat file"):
+        read_table(path)

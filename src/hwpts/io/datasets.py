@@ -223,19 +223,82 @@ def _read_parquet(p: Path, columns=None) -> dict[str, np.ndarray]:
     return out
 
 
-def _read_mat(p: Path) -> dict[str, np.ndarray]:
-    """Each variable of a MATLAB file becomes a column (vectors) or several (``name_1``... for matrices)."""
-    from scipy.io import loadmat
+_MAT_READER = """
+import io, json, sys
+import numpy as np
+import scipy.sparse
+from scipy.io import loadmat
+try:
+    raw = loadmat(sys.argv[1], squeeze_me=False)
+except MemoryError:
+    sys.stdout.write("the variables it declares do not fit in memory (a corrupt size)"); sys.exit(3)
+except Exception as error:
+    sys.stdout.write(str(error) or type(error).__name__); sys.exit(3)
+names, kinds, arrays = [], [], {}
+for name, value in raw.items():
+    if name.startswith("__"):
+        continue
+    names.append(name)
+    if scipy.sparse.issparse(value):
+        kinds.append("sparse")
+        continue
+    arr = np.asarray(value)
+    kinds.append("array" if arr.dtype.kind in "biufc" else "other")
+    if kinds[-1] == "array":
+        arrays[f"v{len(names) - 1}"] = arr
+buf = io.BytesIO()
+np.savez(buf, **arrays)
+sys.stdout.buffer.write(json.dumps({"names": names, "kinds": kinds}).encode() + b"\\n" + buf.getvalue())
+"""
 
-    try:
-        raw = loadmat(p, squeeze_me=False)
-    except Exception as error:  # scipy raises ValueError/TypeError/MatReadError
+
+def _loadmat_isolated(p: Path) -> dict:
+    """``scipy.io.loadmat`` in a child process: its compiled reader can crash the process on a
+    corrupt file (an unknown element type: a segmentation fault, not an exception), which must end
+    in one clear line. Returns the numeric arrays by name, ``"sparse"`` for sparse variables and
+    ``None`` for the others (text, cells, structs)."""
+    import json
+    import subprocess
+    import sys
+
+    from scipy.io.matlab import matfile_version
+
+    try:  # the header, in pure Python: most non-MAT files stop here, without a child process
+        with p.open("rb") as f:
+            major, _ = matfile_version(f)
+    except OSError as error:
+        raise DataError(f"{str(p)!r}: cannot read ({error.strerror or error})") from None
+    except Exception as error:  # noqa: BLE001 - scipy raises ValueError, MatReadError, ...
         raise DataError(f"{str(p)!r}: not a readable MATLAB .mat file ({error})") from None
+    if major == 2:
+        raise DataError(f"{str(p)!r}: a MATLAB v7.3 (HDF5) file; save it with save(..., '-v7') to read it here")
+    proc = subprocess.run([sys.executable, "-c", _MAT_READER, str(p)], capture_output=True, check=False)
+    if proc.returncode == 3:
+        message = proc.stdout.decode("utf-8", errors="replace").strip()
+        raise DataError(f"{str(p)!r}: not a readable MATLAB .mat file ({message})")
+    if proc.returncode != 0:
+        raise DataError(f"{str(p)!r}: not a readable MATLAB .mat file (the reader crashed on it: the file is corrupt)")
+    head, _, body = proc.stdout.partition(b"\n")
+    meta = json.loads(head)
+    with np.load(io.BytesIO(body), allow_pickle=False) as arrays:
+        return {name: (arrays[f"v{i}"] if kind == "array" else "sparse" if kind == "sparse" else None)
+                for i, (name, kind) in enumerate(zip(meta["names"], meta["kinds"]))}
+
+
+def _read_mat(p: Path) -> dict[str, np.ndarray]:
+    """Each variable of a MATLAB file becomes a column (vectors) or several (``name_1``... for matrices).
+
+    The file is parsed in a child process (:func:`_loadmat_isolated`); text, cells and structs are
+    skipped; complex and sparse variables are refused.
+    """
+    raw = _loadmat_isolated(p)
     out = {}
     for name, value in raw.items():
         if name.startswith("__"):
             continue
-        if hasattr(value, "toarray") or hasattr(value, "tocsr"):
+        if value is None:
+            continue
+        if isinstance(value, str):  # "sparse"
             raise DataError(f"{str(p)!r}: variable {name!r} is a sparse matrix; save it as a full (dense) array")
         arr = np.asarray(value)
         if arr.dtype.kind == "c":
