@@ -89,6 +89,8 @@ def workspace(tmp_path_factory):
     savemat(ws / "ragged.mat", {"u1": np.arange(10.0), "u2": np.arange(10.0), "y": np.arange(12.0)})
     savemat(ws / "good.mat", {"u1": d.inputs[:, 0], "u2": d.inputs[:, 1], "y": d.output})
     (ws / "folder").mkdir()
+    os.mkfifo(ws / "fifo.csv")  # reading one would block forever
+    os.mkfifo(ws / "fifo.json")
     (ws / "link.json").symlink_to(ws / "afile")
     foreign = ws / "foreign"
     foreign.mkdir()
@@ -119,6 +121,7 @@ CASES = [
     (["identify", f"{W}/missing.csv", *FIXED, "--out", f"{W}/m.json"], "missing.csv"),
     (["identify", f"{W}/folder", *FIXED, "--out", f"{W}/m.json"], "folder"),
     (["identify", f"{W}/empty.csv", *FIXED, "--out", f"{W}/m.json"], "empty.csv"),
+    (["identify", f"{W}/fifo.csv", *FIXED, "--out", f"{W}/m.json"], "fifo.csv"),
     (["identify", f"{W}/header.csv", *FIXED, "--out", f"{W}/m.json"], "header.csv"),
     (["identify", f"{W}/text.csv", *FIXED, "--out", f"{W}/m.json"], "text.csv"),
     (["identify", f"{W}/nan.csv", *FIXED, "--out", f"{W}/m.json"], "nan.csv"),
@@ -175,6 +178,8 @@ CASES = [
     # --- validate: the model file
     (["validate", f"{W}/missing.json", f"{W}/data.csv"], "missing.json"),
     (["validate", f"{W}/folder", f"{W}/data.csv"], "folder"),
+    (["validate", f"{W}/fifo.json", f"{W}/data.csv"], "fifo.json"),
+    (["plant", "simulate", "--inputs", f"{W}/fifo.csv", "--out", f"{W}/sim.csv"], "fifo.csv"),
     (["validate", f"{W}/notjson.json", f"{W}/data.csv"], "notjson.json"),
     (["validate", f"{W}/truncated.json", f"{W}/data.csv"], "truncated.json"),
     (["validate", f"{W}/schema.json", f"{W}/data.csv"], "schema.json"),

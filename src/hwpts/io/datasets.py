@@ -26,11 +26,9 @@ def read_table(path: str | os.PathLike, columns=None) -> dict[str, np.ndarray]:
     ``columns``: the names the caller needs; a CSV's other columns may hold anything (text, dates)
     and are not converted. Without it every column must be numeric.
     """
-    p = Path(path)
-    if not p.exists():
-        raise DataError(f"{str(p)!r}: no such file")
-    if p.is_dir():
-        raise DataError(f"{str(p)!r}: is a folder, expected a .csv, .parquet or .mat file")
+    from hwpts.io.paths import check_input_file
+
+    p = check_input_file(path, expected="a .csv, .parquet or .mat file")
     suffix = p.suffix.lower()
     if suffix == ".csv":
         return read_csv(p, columns)

@@ -14,7 +14,6 @@ import hashlib
 import json
 import math
 import os
-from pathlib import Path
 
 import numpy as np
 
@@ -120,11 +119,9 @@ def _reject_constant(token):
 
 def load_model(path: str | os.PathLike):
     """Read and validate a model file; return a fitted :class:`~hwpts.identification.PWARX`."""
-    p = Path(path)
-    if not p.exists():
-        raise DataError(f"model {str(p)!r}: no such file")
-    if p.is_dir():
-        raise DataError(f"model {str(p)!r}: is a folder, expected a .json model file")
+    from hwpts.io.paths import check_input_file
+
+    p = check_input_file(path, "model ", "a .json model file")
     try:
         text = p.read_text(encoding="utf-8")
         doc = json.loads(text, parse_constant=_reject_constant)
