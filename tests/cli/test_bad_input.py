@@ -265,19 +265,23 @@ CASES = [
     # --- control
     (["control", "run", "--scenario", "hurricane", "--model", f"{W}/model.json", "--out", f"{W}/c"], "--scenario"),
     (["control", "run", "--scenario", "pump-step", "--model", f"{W}/missing.json", "--out", f"{W}/c"], "missing.json"),
-    (["control", "run", "--scenario", "pump-step", "--model", f"{W}/model.json", "--out", f"{W}/c"], "valve"),
+    (["control", "run", "--scenario", "pump-step", "--model", f"{W}/model.json", "--out", f"{W}/c"],
+     "--model '{ws}/model.json': the model's inputs must be the valve voltage"),
     (["control", "run", "--scenario", "pump-step", "--controllers", "magic", "--out", f"{W}/c"], "magic"),
     (["control", "run", "--scenario", "pump-step", "--setpoint", "1e9", "--out", f"{W}/c"], "--setpoint"),
     (["control", "run", "--scenario", "pump-step", "--duration", "-1", "--out", f"{W}/c"], "--duration"),
     (["control", "run", "--scenario", "pump-step", "--seed", "x", "--out", f"{W}/c"], "--seed"),
     (["control", "study", "--plants", "0", "--seeds", "1", "--out", f"{W}/st"], "--plants"),
     (["control", "study", "--plants", "2", "--seeds", "-1", "--out", f"{W}/st"], "--seeds"),
+    (["control", "study", "--plants", "1", "--seeds", "1", "--model", f"{W}/model.json", "--out", f"{W}/st"],
+     "--model '{ws}/model.json'"),
 ]
 
 
 @pytest.mark.parametrize("argv, needle", CASES, ids=[" ".join(a)[:70] or "(none)" for a, _ in CASES])
 def test_bad_input_is_one_line_and_changes_nothing(workspace, capsys, argv, needle):
     argv = [a.replace(W, str(workspace)) for a in argv]
+    needle = needle.replace(W, str(workspace))
     before = _snapshot(workspace)
     capsys.readouterr()
     try:

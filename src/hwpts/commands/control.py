@@ -124,6 +124,19 @@ def _model_bank(args):
         f"identified on the test bed (method 'paper', seed {args.seed})"
 
 
+def _bank(args, doc, sample_time):
+    """The controllers' model bank; a model file no controller can be designed from is named."""
+    from hwpts.control.model import ModelBank
+    from hwpts.errors import DataError
+
+    try:
+        return ModelBank(doc, sample_time)
+    except DataError as error:
+        if args.model:
+            raise DataError(f"--model {str(args.model)!r}: {error}") from None
+        raise
+
+
 STUDY_SCHEMA = "hwpts.control-study/1"
 
 
@@ -135,7 +148,6 @@ def study_command(args) -> int:
     import numpy as np
 
     from hwpts.control.controllers import parse_names
-    from hwpts.control.model import ModelBank
     from hwpts.control.study import PLANT_TOLERANCES, TARGETS, run_study
     from hwpts.errors import ParameterError
     from hwpts.io.atomic import write_text_atomic
@@ -148,7 +160,7 @@ def study_command(args) -> int:
     check_replaceable(args.out, STUDY_SCHEMA)
     start = time.perf_counter()
     _, doc, sample_time, half_width, source = _model_bank(args)
-    ModelBank(doc, sample_time)  # refuse a model a controller cannot be designed from, before any work
+    _bank(args, doc, sample_time)  # refuse a model a controller cannot be designed from, before any work
     result = run_study(doc, sample_time, half_width, args.plants, args.seeds, names, args.scenario, args.seed,
                        args.scheduler, args.duration, progress=sys.stderr.isatty(), n_workers=args.workers)
     summary = {"schema": STUDY_SCHEMA, "scenario": args.scenario, "plants": args.plants, "seeds": args.seeds,
@@ -181,7 +193,6 @@ def run_command(args) -> int:
     from tqdm import tqdm
 
     from hwpts.control.controllers import parse_names
-    from hwpts.control.model import ModelBank
     from hwpts.control.run import SCHEMA, check_setpoint, run_scenario
     from hwpts.errors import ParameterError
     from hwpts.io.atomic import write_bytes_atomic, write_text_atomic
@@ -197,7 +208,7 @@ def run_command(args) -> int:
     check_replaceable(args.out, SCHEMA)
     start = time.perf_counter()
     model, doc, sample_time, half_width, source = _model_bank(args)
-    bank = ModelBank(doc, sample_time)
+    bank = _bank(args, doc, sample_time)
     check_setpoint(bank, args.setpoint, doc["training"]["output_range"])
     with tqdm(total=1000, desc=f"control {args.scenario}", unit="‰", disable=not sys.stderr.isatty(), leave=False) as bar:
         def progress(fraction, name):
