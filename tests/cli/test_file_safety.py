@@ -230,7 +230,7 @@ def test_a_signal_during_reproduce_keeps_the_earlier_run(tmp_path, sig):
         assert sorted(p.name for p in tmp_path.iterdir() if p.name not in ("results", "numba-cache")) == []
 
 
-@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGKILL], ids=["SIGINT", "SIGKILL"])
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGKILL], ids=["SIGINT", "SIGTERM", "SIGKILL"])
 def test_a_signal_during_a_sweep_keeps_the_earlier_file(tmp_path, sig):
     out = tmp_path / "sweep.csv"
     assert main(["plant", "sweep", "--out", str(out), "--voltages", "1.2:3.8:3", "--pump-speeds", "200:1000:3"]) == 0
@@ -243,8 +243,11 @@ def test_a_signal_during_a_sweep_keeps_the_earlier_file(tmp_path, sig):
     if proc.returncode == 0:
         pytest.skip("the sweep finished before the signal (a very fast machine)")
     assert out.read_bytes() == kept
-    if sig == signal.SIGINT:
+    if sig != signal.SIGKILL:
         assert proc.returncode == 130 and "Traceback" not in err
+        assert err.strip().splitlines()[-1] == "hwpts: interrupted", err
+    else:
+        assert proc.returncode == -signal.SIGKILL
     # after the next run to the same file, no temporary file is left (a killed writer's included)
     assert main(["plant", "sweep", "--out", str(out), "--voltages", "1.2:3.8:3", "--pump-speeds", "200:1000:3"]) == 0
     assert sorted(p.name for p in tmp_path.iterdir()) in (["sweep.csv"], ["numba-cache", "sweep.csv"])
