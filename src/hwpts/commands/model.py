@@ -34,16 +34,38 @@ def _rows(text: str | None):
     return slice(start, stop)
 
 
+# conventional names of a time column in seconds, tried in this order when --time is not given
+TIME_COLUMNS = ("time_s", "t_s", "time", "t")
+NO_TIME = "none"  # --time none: no time column, the sample index is the time axis
+
+
 def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
     """The named columns of a data file as an :class:`IODataset`; its ``sample_time_s`` attribute
-    is the sample period from the time column, or None when the file has none (time = row index)."""
+    is the sample period from the time column, or None when the file has none (time = row index).
+
+    Without ``time_name`` the time column is the first of :data:`TIME_COLUMNS` the file holds (a
+    numeric column; one that is not a signal), so that a model that knows its sample time is never
+    applied silently to data sampled at another rate; ``time_name="none"`` uses the row index.
+    """
     from hwpts.dataset import IODataset
     from hwpts.io.datasets import read_table
 
-    columns = read_table(path, [*input_names, output_name, *([time_name] if time_name else ["time_s"])])
-    if time_name is not None and time_name not in columns:
+    signals = [*input_names, output_name]
+    if time_name == NO_TIME:
+        candidates = []
+    elif time_name is not None:
+        candidates = [time_name]
+    else:
+        candidates = [c for c in TIME_COLUMNS if c not in signals]
+    try:
+        columns = read_table(path, [*signals, *candidates])
+    except DataError:
+        if time_name is not None or not candidates:
+            raise
+        columns = read_table(path, signals)  # a conventionally named column that holds text is no time axis
+    if time_name not in (None, NO_TIME) and time_name not in columns:
         raise DataError(f"{str(path)!r}: no time column {time_name!r}; available columns are {sorted(columns)}")
-    missing = [c for c in [*input_names, output_name] if c not in columns]
+    missing = [c for c in signals if c not in columns]
     if missing:
         raise DataError(f"{str(path)!r}: no column(s) {missing}; available columns are {sorted(columns)}")
     sl = _rows(rows)
@@ -51,7 +73,9 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
     n = len(cols[output_name])
     if n == 0:
         raise DataError(f"{str(path)!r}: no rows selected (--rows {rows})")
-    tname = time_name if time_name is not None else ("time_s" if "time_s" in cols else None)
+    tname = next((c for c in candidates if c in cols), None)
+    detected = time_name is None and tname is not None
+    hint = f" ({tname!r} is taken as the time column by its name; --time none uses the sample index)" if detected else ""
     timed = tname is not None
     if tname is None:
         # time = sample index of the file (keeps the original numbering under --rows)
@@ -60,8 +84,11 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
     try:
         data = IODataset.from_columns(cols, list(input_names), output_name, time_name=tname)
     except DataError as error:
-        raise DataError(f"{str(path)!r}: {error}") from None
-    dt = _sample_time(data, path, tname) if timed else None
+        raise DataError(f"{str(path)!r}: {error}{hint}") from None
+    try:
+        dt = _sample_time(data, path, tname) if timed else None
+    except DataError as error:
+        raise DataError(f"{error}{hint}") from None
     return data, dt
 
 
@@ -395,8 +422,8 @@ def cmd_predict(args) -> int:
 
 def _common_data_args(parser):
     parser.add_argument("--time", metavar="COL", default=None,
-                        help="time column [s] (default: time_s if present, else the sample index); its step "
-                             "is the sample time")
+                        help="time column [s] (default: the first of time_s, t_s, time, t present, else the "
+                             "sample index; 'none': the sample index); its step is the sample time")
     parser.add_argument("--rows", metavar="START:STOP", default=None,
                         help="use only these rows (Python slice: 0:5000; write --rows=-1001: for a negative start)")
 
