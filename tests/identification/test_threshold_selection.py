@@ -133,10 +133,11 @@ def test_blocked_split_drops_the_regressor_rows_spanning_the_gap():
 def test_a_method_that_trails_twice_stops_growing():
     search = PWARXSearch(patience=2)
 
-    def rows(alt_free, alt_one):
+    def rows(alt_free, alt_one, state=None):
         return [{"params": {"segmentation": "threshold"}, "mean_fit_percent": 96.0, "mean_one_step_fit_percent": 99.5},
                 {"params": {"segmentation": "alternating"}, "mean_fit_percent": alt_free,
-                 "mean_one_step_fit_percent": alt_one}]
+                 "mean_one_step_fit_percent": alt_one, "diverged": state == "diverged",
+                 "pruned": state == "pruned", "error": "failed" if state == "failed" else None}]
 
     behind = {"threshold": 0, "alternating": 0}
     active = ["threshold", "alternating"]
@@ -144,10 +145,31 @@ def test_a_method_that_trails_twice_stops_growing():
     assert search._still_racing(rows(95.0, 99.0), active, behind) == active
     # far in free run but as good one step ahead (misfit 0.55 vs 0.5): kept
     assert search._still_racing(rows(80.0, 99.45), active, behind) == active
-    # far in both, twice in a row: dropped; a diverged or pruned candidate (None) is no evidence
+    # far in both, twice in a row: dropped; a failed fit (an error) is no evidence either way
     assert search._still_racing(rows(90.0, 99.0), active, behind) == active
-    assert search._still_racing(rows(None, None), active, behind) == active
+    assert search._still_racing(rows(None, None, "failed"), active, behind) == active
     assert search._still_racing(rows(90.0, 99.0), active, behind) == ["threshold"]
+
+
+def test_a_method_that_diverges_or_is_pruned_twice_stops_growing():
+    search = PWARXSearch(patience=2)
+
+    def rows(state):
+        return [{"params": {"segmentation": "threshold"}, "mean_fit_percent": 96.0, "mean_one_step_fit_percent": 99.5},
+                {"params": {"segmentation": "alternating"}, "mean_fit_percent": None,
+                 "mean_one_step_fit_percent": None, "diverged": state == "diverged", "pruned": state == "pruned"}]
+
+    for first, second in (("diverged", "pruned"), ("pruned", "pruned"), ("diverged", "diverged")):
+        behind = {"threshold": 0, "alternating": 0}
+        active = ["threshold", "alternating"]
+        assert search._still_racing(rows(first), active, behind) == active
+        assert search._still_racing(rows(second), active, behind) == ["threshold"]
+    # when every method diverged there is no leader: nobody is dropped
+    both = [{"params": {"segmentation": m}, "mean_fit_percent": None, "mean_one_step_fit_percent": None,
+             "diverged": True, "pruned": False} for m in ("threshold", "alternating")]
+    behind = {"threshold": 0, "alternating": 0}
+    for _ in range(3):
+        assert search._still_racing(both, ["threshold", "alternating"], behind) == ["threshold", "alternating"]
 
 
 def test_threshold_costs_are_reused_across_region_counts():

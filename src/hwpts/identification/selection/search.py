@@ -411,22 +411,27 @@ class PWARXSearch(BaseEstimator):
 
     def _still_racing(self, rows, active, behind):
         """The methods tried with more regions: a method that trails the best of this region count
-        by ``DROP_MARGIN`` (2 points of free-run fit and 20 % more one-step misfit), ``patience``
-        counts in a row, stops (its growth would cost the most and not win)."""
+        by ``DROP_MARGIN`` (2 points of free-run fit and 20 % more one-step misfit), or whose model
+        diverged or was pruned while another method's scored, ``patience`` counts in a row, stops
+        (its growth would cost the most and not win)."""
         if len(active) < 2:
             return active
         free = {r["params"]["segmentation"]: self._score(r) for r in rows}
         one = {r["params"]["segmentation"]: (r["mean_one_step_fit_percent"]
                                              if r["mean_one_step_fit_percent"] is not None else -np.inf)
                for r in rows}
+        lost = {r["params"]["segmentation"] for r in rows if r.get("diverged") or r.get("pruned")}
         lead_free, lead_one = max(free.values()), max(one.values())
         keep = []
         for m in active:
-            if not np.isfinite(free.get(m, -np.inf)):
-                keep.append(m)  # failed, diverged or pruned here: no evidence either way (a method
-                continue        # may fail with few regions and win with more)
-            trails = (free[m] < lead_free - DROP_MARGIN[0]
-                      and 100.0 - one.get(m, -np.inf) > DROP_MARGIN[1] * (100.0 - lead_one))
+            if m in lost and np.isfinite(lead_free):
+                trails = True  # diverged, or pruned 10 points behind, while another method scored
+            elif not np.isfinite(free.get(m, -np.inf)):
+                keep.append(m)  # failed here: no evidence either way (a method may fail with few
+                continue        # regions and win with more)
+            else:
+                trails = (free[m] < lead_free - DROP_MARGIN[0]
+                          and 100.0 - one.get(m, -np.inf) > DROP_MARGIN[1] * (100.0 - lead_one))
             behind[m] = behind[m] + 1 if trails else 0
             if behind[m] < max(int(self.patience), 1):
                 keep.append(m)
