@@ -64,6 +64,12 @@ class HysteresisInverse:
         self.command = float(command)
         self.effective = float(command)
 
+    def set_width(self, half_width: float, effective: float) -> None:
+        """A new estimate of the play's half-width [V] and of its present output [V] (online estimation)."""
+        self.r = float(half_width)
+        lo, hi = self.command - self.r, self.command + self.r
+        self.effective = min(max(float(effective), lo), hi)
+
     def __call__(self, desired: float) -> float:
         lo, hi = self.limits
         if self.enabled:

@@ -20,6 +20,10 @@ Every 10 ms sample the controller
    its one-step prediction is added to every predicted step (a constant disturbance on the ARX
    equation, which the model's own dynamics carry to the output: integral action without an
    integrator to wind up).
+5. estimates the valve play's half-width online (:mod:`hwpts.control.controllers.play`: the model's
+   free-run error regressed on the valve direction, at the model rate, through a dead zone) and lets the hysteresis
+   inverse follow it, so that a valve whose play is not the identified one (wear, another unit)
+   is still inverted (``adapt_width=False``: the identified width, fixed).
 """
 
 from __future__ import annotations
@@ -31,6 +35,7 @@ import numpy as np
 from scipy.optimize import lsq_linear
 
 from hwpts.control.controllers.base import Controller, HysteresisInverse
+from hwpts.control.controllers.play import AdaptiveInverse, PlayWidthEstimator
 from hwpts.control.model import ModelBank
 
 RATE_LIMIT_V_PER_S = 20.0
@@ -45,10 +50,12 @@ class MPCController(Controller):
 
     def __init__(self, bank: ModelBank, half_width: float, inverse: bool = True, sample_time: float = 0.01,
                  horizon: int = 6, moves: int = 3, move_weight: float = 50.0,
-                 rate_limit: float = RATE_LIMIT_V_PER_S, disturbance_filter: float = 0.6):
+                 rate_limit: float = RATE_LIMIT_V_PER_S, disturbance_filter: float = 0.6, adapt_width: bool = True):
         super().__init__(sample_time)
         self.bank = bank
         self.inverse = HysteresisInverse(half_width, inverse)
+        self.adaptive = AdaptiveInverse(self.inverse, PlayWidthEstimator(bank, half_width, sample_time)
+                                        if adapt_width else None)
         self.ratio = max(1, int(round(bank.sample_time / sample_time)))
         self.horizon = int(horizon)
         self.moves = int(moves)
@@ -78,7 +85,7 @@ class MPCController(Controller):
 
     def reset(self, setpoint, speed, pump, command):
         """Start in steady state: fill the model-rate history with the present speed, valve and pump."""
-        self.inverse.reset(command)
+        self.adaptive.reset(command, speed, pump)
         for q, v in ((self._y, speed), (self._u1, command), (self._u2, pump)):
             q.clear()
             q.extend([v] * q.maxlen)
@@ -124,6 +131,7 @@ class MPCController(Controller):
 
     def step(self, setpoint, speed, pump):
         """One 10 ms sample: predict over the horizon on the region sequence, solve the QP, apply its first move [V]."""
+        self.adaptive.observe(speed, pump)
         self._y.append(speed)
         self._u1.append(self.inverse.effective)
         self._u2.append(pump)
@@ -142,7 +150,7 @@ class MPCController(Controller):
         # dummy last entries are dropped by _predict)
         y_model = np.append(self._model_history(0), 0.0)
         u1_hist = np.append(u1_hist, 0.0)
-        return self.inverse(float(self._optimize(setpoint, y_model, u1_hist, u2_hist)))
+        return self.adaptive(float(self._optimize(setpoint, y_model, u1_hist, u2_hist)))
 
     def _optimize(self, setpoint, y_model, u1_hist, u2_hist) -> float:
         """The plan's first move (effective valve voltage) from the QP on the predicted region sequence."""

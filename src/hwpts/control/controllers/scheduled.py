@@ -13,6 +13,7 @@ import math
 
 from hwpts.control.controllers.base import Controller, HysteresisInverse, LowPass, ModelRateHistory, PILaw
 from hwpts.control.controllers.pi import SPEED_FILTER_S, region_gains
+from hwpts.control.controllers.play import AdaptiveInverse, PlayWidthEstimator
 from hwpts.control.model import ModelBank
 
 CLOSED_LOOP_TIME_S = 0.08
@@ -36,10 +37,13 @@ class ScheduledController(Controller):
     has_modes = True
 
     def __init__(self, bank: ModelBank, half_width: float, inverse: bool = True, nominal_pump: float = 700.0,
-                 sample_time: float = 0.01, closed_loop_time: float = CLOSED_LOOP_TIME_S, bumpless: bool = True):
+                 sample_time: float = 0.01, closed_loop_time: float = CLOSED_LOOP_TIME_S, bumpless: bool = True,
+                 adapt_width: bool = True):
         super().__init__(sample_time)
         self.bank = bank
         self.inverse = HysteresisInverse(half_width, inverse)
+        self.adaptive = AdaptiveInverse(self.inverse, PlayWidthEstimator(bank, half_width, sample_time)
+                                        if adapt_width else None)
         self.bumpless = bumpless
         self.nominal_pump = float(nominal_pump)
         lims = self.inverse.effective_limits
@@ -77,7 +81,7 @@ class ScheduledController(Controller):
 
     def reset(self, setpoint, speed, pump, command):
         """Start without a bump in the region of the present operating point."""
-        self.inverse.reset(command)
+        self.adaptive.reset(command, speed, pump)
         self.speed_filter.reset(speed)
         self.pump_filter.reset(pump)
         self.history.fill(speed, command, pump)
@@ -94,6 +98,7 @@ class ScheduledController(Controller):
 
     def step(self, setpoint, speed, pump):
         """One 10 ms sample: choose the region, switch laws bumplessly, apply its PI law with the region's feedforward."""
+        self.adaptive.observe(speed, pump)
         y = self.speed_filter(speed)
         w = self.pump_filter(pump)
         if self.history.add(speed, self.inverse.effective, pump):
@@ -117,7 +122,7 @@ class ScheduledController(Controller):
             if law.gains.kp * e * toward > 0.0 and law.integral * toward < 0.0:
                 law.integral = 0.0
         desired = law(e, self.feedforward)
-        self.command = self.inverse(desired)
+        self.command = self.adaptive(desired)
         return self.command
 
 
