@@ -1,5 +1,7 @@
 """``threshold`` segmentation (SETAR/TARX) and the blocked cross-validation scheme of select_model."""
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -187,3 +189,31 @@ def test_threshold_costs_are_reused_across_region_counts():
     th._COST_CACHE.clear()
     assert th.optimal_split(x, Phi, y, 3, 50) == third and th.optimal_split(x, Phi, y, 2, 50) == first
     assert abs(first[1][0] - 0.2) < 0.02
+
+
+def test_the_polish_restarts_its_free_run_at_every_break():
+    """A cross-validation fold joins two stretches of the record: the polish must simulate each one
+    from its own initial conditions, not carry the free run across the junction (where it would
+    chase the jump in the measurements and bend the parameters to do so)."""
+    rng = np.random.default_rng(3)
+    u = rng.uniform(-1, 1, (800, 1))
+    joined = np.zeros(800)
+    joined[400] = 5.0  # the second stretch starts from another state (another experiment)
+    for k in range(1, 800):  # an ARX system with a slow pole: the jump would take long to forget
+        if k != 400:
+            joined[k] = 0.95 * joined[k - 1] + 0.5 * u[k - 1, 0] + 0.1
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = PWARX(1, 1, 1, n_regions=1, segmentation="average", polish=True).fit(u, joined, breaks=[400])
+    # least squares is exact on each stretch's rows; simulated stretch by stretch, it is also the
+    # polish's optimum (zero simulation error), so the parameters stay
+    np.testing.assert_allclose(model.theta_[0], [0.95, 0.5, 0.1], atol=1e-6)
+    info = model.segmentation_info_["polish"]
+    assert info["initial_sse"] < 1e-12
+    # simulated straight through the junction, the jump is a simulation error to fit
+    from hwpts.identification.polish import polish_free_run
+
+    center, half = model.divergence_band()
+    _, across = polish_free_run(model.structure_, model.partition_, model.theta_, ("affine",), u, joined,
+                                center, half)
+    assert across["initial_sse"] > 1.0

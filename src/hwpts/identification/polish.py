@@ -19,9 +19,20 @@ import numpy as np
 from hwpts.identification.simulation import simulate_pwarx
 
 
+def _stretches(n: int, m: int, breaks) -> list[tuple[int, int]]:
+    """``[start, stop)`` of the stretches between ``breaks`` long enough to simulate (more than
+    ``m`` samples: the first ``m`` are the stretch's initial conditions)."""
+    edges = [0] + sorted({int(b) for b in (breaks or ()) if 0 < int(b) < n}) + [n]
+    return [(a, b) for a, b in zip(edges[:-1], edges[1:]) if b - a > m]
+
+
 def polish_free_run(structure, partition, theta, kinds, inputs, output, center, bound,
-                    max_nfev: int | None = None) -> tuple[np.ndarray, dict]:
-    """Return (theta, info) after simulation-error minimisation over the affine modes' parameters."""
+                    max_nfev: int | None = None, breaks=None) -> tuple[np.ndarray, dict]:
+    """Return (theta, info) after simulation-error minimisation over the affine modes' parameters.
+
+    ``breaks``: sample positions where the record restarts (two stretches joined, as in a
+    cross-validation fold); each stretch is simulated from its own first measured outputs, since a
+    free run carried across a junction would chase the jump in the measurements."""
     from scipy.optimize import least_squares
 
     theta = np.asarray(theta, dtype=float)
@@ -32,15 +43,27 @@ def polish_free_run(structure, partition, theta, kinds, inputs, output, center, 
         mask[i, cols] = True
     m = structure.max_lag
     y = np.asarray(output, dtype=float)
-    target = y[m:]
+    u = np.asarray(inputs, dtype=float)
+    parts = _stretches(y.shape[0], m, breaks)
+    if not parts:  # no stretch longer than its initial conditions: nothing to simulate
+        return theta, {"initial_sse": 0.0, "accepted": False}
+    target = np.concatenate([y[a + m:b] for a, b in parts])
     penalty = abs(center) + bound
+
+    def simulate(th):
+        """The free run of every stretch (outputs after its initial conditions), and whether any diverged."""
+        outs, diverged = [], False
+        for a, b in parts:
+            sim = simulate_pwarx(structure, partition, th, u[a:b], y[a:b], center, bound)
+            outs.append(sim.output[m:])
+            diverged = diverged or sim.diverged
+        return np.concatenate(outs), diverged
 
     def residuals(p):
         th = theta.copy()
         th[mask] = p
-        sim = simulate_pwarx(structure, partition, th, inputs, y, center, bound)
-        out = sim.output[m:]
-        if sim.diverged:
+        out, diverged = simulate(th)
+        if diverged:
             out = np.where(np.isfinite(out), out, penalty)
         return out - target
 
@@ -58,8 +81,8 @@ def polish_free_run(structure, partition, theta, kinds, inputs, output, center, 
         return theta, info
     th = theta.copy()
     th[mask] = res.x
-    sim = simulate_pwarx(structure, partition, th, inputs, y, center, bound)
-    cost1 = float(np.sum((sim.output[m:] - target) ** 2)) if not sim.diverged else float("inf")
+    out, diverged = simulate(th)
+    cost1 = float(np.sum((out - target) ** 2)) if not diverged else float("inf")
     info.update({"final_sse": cost1, "nfev": int(res.nfev)})
     if cost1 < cost0:
         info["accepted"] = True

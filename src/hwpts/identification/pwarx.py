@@ -326,7 +326,8 @@ class PWARX(BaseEstimator):
             from hwpts.identification.polish import polish_free_run
 
             center, half = self.divergence_band()
-            self.theta_, info = polish_free_run(structure, partition, self.theta_, kinds, u, yy, center, half)
+            self.theta_, info = polish_free_run(structure, partition, self.theta_, kinds, u, yy, center, half,
+                                                breaks=breaks)
             self.segmentation_info_["polish"] = info
         return self
 

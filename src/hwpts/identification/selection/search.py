@@ -174,8 +174,9 @@ class PWARXSearch(BaseEstimator):
     refit_margin : float
         The refit on all data must score on the blocks at least its cross-validated mean minus this.
     try_polish : bool or "auto"
-        Score the winner with the simulation-error polish too; "auto": only on records of at most
-        5,000 samples with an autoregressive part (the polish costs a dense Jacobian).
+        Score the winner with the simulation-error polish too; "auto": when the model has an
+        autoregressive part (without one the free run is the one-step prediction, which least
+        squares already minimises).
     n_jobs : int or None
         Processes for the candidates (joblib); ``None`` runs them in this process.
     progress : bool
@@ -491,7 +492,7 @@ class PWARXSearch(BaseEstimator):
             params = dict(row["params"])
             polish = self.try_polish
             if polish == "auto":
-                polish = y.shape[0] <= 5000 and params.get("output_order", base.output_order) > 0
+                polish = params.get("output_order", base.output_order) > 0
             if polish and not clone(base).set_params(**params).polish:
                 trial = _evaluate(base, {**params, "polish": True}, u, y, splits, -np.inf, *self._names)
                 trial["stage"] = "polish"
