@@ -41,12 +41,15 @@ def test_mpc_follows_a_play_wider_or_narrower_than_identified(full_model_doc, fa
     c, true, r_hat, _, _ = _estimate(full_model_doc, factor)
     est = c.adaptive.estimator.width
     assert c.inverse.r == pytest.approx(est, abs=0.0021)
-    # the estimate moved a good part of the way from the identified width towards the valve's, and is
-    # not left short of a wider play (a play wider than the inverse's is a dead band: a limit cycle)
-    moved = (est - r_hat) / (true - r_hat)
-    assert moved > 0.33
-    assert est > true - 0.02
     assert c.adaptive.estimator.bounds[0] <= est <= c.adaptive.estimator.bounds[1]
+    moved = (est - r_hat) / (true - r_hat)
+    if factor > 1.0:
+        # a play wider than the inverse's is a dead band (a limit cycle): the estimate must not stay short
+        assert est > true - 0.02
+    else:
+        # a narrower play only makes the reversals overshoot a little: the estimate moves towards it
+        # (the dead zone stops it short) and not past it
+        assert 0.15 < moved < 1.0
 
 
 def test_estimate_stays_at_the_identified_width_on_the_identified_valve(full_model_doc):

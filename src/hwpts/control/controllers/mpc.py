@@ -131,7 +131,7 @@ class MPCController(Controller):
 
     def step(self, setpoint, speed, pump):
         """One 10 ms sample: predict over the horizon on the region sequence, solve the QP, apply its first move [V]."""
-        self.adaptive.observe(speed, pump)
+        self.adaptive.observe(speed, pump, setpoint)
         self._y.append(speed)
         self._u1.append(self.inverse.effective)
         self._u2.append(pump)

@@ -37,7 +37,7 @@ from hwpts.control.model import ModelBank
 
 WIDTH_SPAN = 0.5
 """The estimate stays within the identified width x (1 - span ... 1 + span)."""
-BIAS_TIME_S = 2.0
+BIAS_TIME_S = 0.5
 """Time constant of the high-pass (a slow disturbance, the model's offset) [s]."""
 WINDOW_S = 60.0
 """Time constant of the least-squares window [s]."""
@@ -47,6 +47,14 @@ DEAD_ZONE = 0.03
 """Estimated differences smaller than this share of the identified width leave the width as it is."""
 WARMUP_S = 10.0
 """The estimate stays at the identified width for this long after a reset [s]."""
+TRANSIENT_BAND = 0.008
+"""Where the speed error's mean over the last ``TRANSIENT_TIME_S`` exceeds this share of the set-point,
+the loop is in a transient (a load or pump step, the set-point out of reach; a worn valve's limit
+cycle averages out): those samples are left out of the estimate."""
+TRANSIENT_TIME_S = 0.5
+"""Time constant of that mean [s]."""
+TRANSIENT_HOLD_S = 2.0
+"""... and so are the samples for this long after one [s]."""
 
 
 class PlayWidthEstimator:
@@ -57,7 +65,8 @@ class PlayWidthEstimator:
 
     def __init__(self, bank: ModelBank, half_width: float, sample_time: float = 0.01, span: float = WIDTH_SPAN,
                  bias_time_s: float = BIAS_TIME_S, window_s: float = WINDOW_S, adapt_time_s: float = ADAPT_TIME_S,
-                 dead_zone: float = DEAD_ZONE, warmup_s: float = WARMUP_S):
+                 dead_zone: float = DEAD_ZONE, warmup_s: float = WARMUP_S, transient_band: float = TRANSIENT_BAND,
+                 transient_hold_s: float = TRANSIENT_HOLD_S):
         self.bank = bank
         self.nominal = float(half_width)
         self.bounds = (self.nominal * (1.0 - span), self.nominal * (1.0 + span))
@@ -68,6 +77,9 @@ class PlayWidthEstimator:
         self.a_win = 1.0 - math.exp(-period / window_s)
         self.a_adapt = 1.0 - math.exp(-period / adapt_time_s)
         self.warmup = int(math.ceil(warmup_s / period))
+        self.transient_band = float(transient_band)
+        self.a_transient = 1.0 - math.exp(-period / TRANSIENT_TIME_S)
+        self.hold = int(math.ceil(transient_hold_s / period))
         self.length = bank.max_lag + 2
         self.reset(1.2, 0.0, 0.0)
 
@@ -83,8 +95,10 @@ class PlayWidthEstimator:
         self.vf = [0.0] * n
         self.zf = [0.0] * n
         self.pf = [0.0] * n
-        self._acc = np.zeros(3)
+        self._acc = np.zeros(4)
         self._first = (float(command), 0.0)
+        self._since_transient = self.hold
+        self.error_mean = 0.0
         self._count = 0
         self.mean = None
         self.R = np.zeros((4, 4))
@@ -93,13 +107,14 @@ class PlayWidthEstimator:
         self.gain_ratio = 1.0
         self.difference = 0.0
 
-    def observe(self, speed: float, pump: float, effective: float, direction: float) -> bool:
+    def observe(self, speed: float, pump: float, effective: float, direction: float,
+                setpoint: float = math.nan) -> bool:
         """One loop sample: measured ``speed`` and ``pump`` [r/min], the inverse's play output estimate
-        ``effective`` [V] and ``direction`` (+1 last pushed up, -1 down) over the last interval. True when
-        a model-rate sample completed."""
+        ``effective`` [V] and ``direction`` (+1 last pushed up, -1 down) over the last interval, and the
+        ``setpoint`` [r/min] (nan: no transient detection). True when a model-rate sample completed."""
         if self._count == 0:
             self._first = (float(effective), float(direction))
-        self._acc += (speed, effective, pump)
+        self._acc += (speed, effective, pump, setpoint)
         self._count += 1
         if self._count < self.ratio:
             return False
@@ -110,6 +125,12 @@ class PlayWidthEstimator:
             del seq[0]
         self._acc[:] = 0.0
         self._count = 0
+        if math.isfinite(m[3]) and m[3] != 0.0:
+            self.error_mean += self.a_transient * ((m[0] - m[3]) / m[3] - self.error_mean)
+        if abs(self.error_mean) > self.transient_band:
+            self._since_transient = 0
+        else:
+            self._since_transient += 1
         self._update()
         return True
 
@@ -139,6 +160,9 @@ class PlayWidthEstimator:
             self.mean = sig.copy()
         self.mean += self.a_bias * (sig - self.mean)
         hp = sig - self.mean
+        if self._since_transient < self.hold:
+            # a large transient: the first-order error model does not hold there; the model runs on
+            return
         self.R += self.a_win * (np.outer(hp, hp) - self.R)
         self.updates += 1
         if self.updates < self.warmup:
@@ -180,10 +204,10 @@ class AdaptiveInverse:
             self.estimator.reset(command, speed, pump)
             self.inverse.r = self.estimator.nominal
 
-    def observe(self, speed: float, pump: float) -> None:
-        """This sample's measured speed and pump speed [r/min], before the command is computed."""
+    def observe(self, speed: float, pump: float, setpoint: float = math.nan) -> None:
+        """This sample's measured speed and pump speed [r/min] and the set-point, before the command is computed."""
         if self.estimator is not None:
-            self.estimator.observe(speed, pump, self.inverse.effective, self.direction)
+            self.estimator.observe(speed, pump, self.inverse.effective, self.direction, setpoint)
 
     def __call__(self, desired: float) -> float:
         """The coil command [V] for the ``desired`` play output [V]; the width follows the estimate."""

@@ -98,7 +98,7 @@ class ScheduledController(Controller):
 
     def step(self, setpoint, speed, pump):
         """One 10 ms sample: choose the region, switch laws bumplessly, apply its PI law with the region's feedforward."""
-        self.adaptive.observe(speed, pump)
+        self.adaptive.observe(speed, pump, setpoint)
         y = self.speed_filter(speed)
         w = self.pump_filter(pump)
         if self.history.add(speed, self.inverse.effective, pump):
