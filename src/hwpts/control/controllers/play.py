@@ -3,7 +3,7 @@
 The hysteresis inverse needs the play's half-width r. The identified value holds for the valve it
 was identified on; a valve whose play differs (wear, another unit: the study's plants) defeats the
 inverse on every reversal: with the true play wider by dr the spool stays put for 2 dr more of
-command, narrower and it jumps by 2 dr too far, either way an error of about |valve gain| x dr that
+command, narrower and it jumps by 2 dr too far, either way an error of about the valve gain times dr that
 changes sign with the valve's direction (about 45 r/min, 4.5 % of the set-point, for dr = 0.05 V).
 
 With the inverse's estimate u of the play output, the true output is u - s dr, where s is +1 while
