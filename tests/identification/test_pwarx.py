@@ -270,3 +270,44 @@ def test_a_dataset_at_another_sample_time_is_refused():
     fast = IODataset(t / 4, d.inputs, d.output, ("u1", "u2"), "y")
     with pytest.raises(DataError, match="sample time 0.0025 s differs from the model's 0.01 s"):
         model.simulate(fast)
+
+
+def test_search_and_polish_run_blas_single_threaded(monkeypatch):
+    """The search's small least squares, classifiers and the polish's SVDs run with one BLAS thread
+    (threaded BLAS on a busy machine spin-waits: 1.2 s instead of 0.02 s per polish SVD)."""
+    from threadpoolctl import threadpool_info
+
+    import hwpts.identification.polish as polish_module
+    import hwpts.identification.selection.search as search_module
+    from hwpts.identification import PWARXSearch
+
+    from scipy.optimize import least_squares
+
+    seen = []
+    score_split, polish_free_run = search_module._score_split, polish_module.polish_free_run
+
+    def blas_threads():
+        return max(i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas")
+
+    def spy_split(*args, **kwargs):
+        seen.append(("split", blas_threads()))
+        return score_split(*args, **kwargs)
+
+    def spy_least_squares(*args, **kwargs):
+        seen.append(("polish", blas_threads()))
+        return least_squares(*args, **kwargs)
+
+    monkeypatch.setattr(search_module, "_score_split", spy_split)
+    monkeypatch.setattr("scipy.optimize.least_squares", spy_least_squares)
+    rng = np.random.default_rng(0)
+    u = rng.uniform(-1, 1, (600, 1))
+    y = np.zeros(600)
+    for k in range(1, 600):
+        y[k] = 0.5 * y[k - 1] + (u[k - 1, 0] if u[k - 1, 0] > 0 else -0.5 * u[k - 1, 0])
+    PWARXSearch(PWARX(1, 1, 1, random_state=0), max_regions=2).fit(u, y)
+    assert {kind for kind, _ in seen} == {"split", "polish"}
+    assert all(n == 1 for _, n in seen)
+    seen.clear()
+    PWARX(1, 1, 1, n_regions=2, segmentation="threshold", polish=True).fit(u, y)  # the polish alone too
+    assert seen == [("polish", 1)]
+    assert polish_free_run is polish_module.polish_free_run

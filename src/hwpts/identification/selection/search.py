@@ -45,6 +45,7 @@ import warnings
 
 import numpy as np
 from sklearn.base import BaseEstimator, clone
+from threadpoolctl import threadpool_limits
 
 from hwpts.errors import HwptsError, IdentificationError, ParameterError
 from hwpts.identification.metrics import fit_percent
@@ -332,20 +333,25 @@ class PWARXSearch(BaseEstimator):
             from tqdm import tqdm
 
             bar = tqdm(desc="model search", unit="candidate", disable=None)
-        try:
-            if self.param_grid is not None:
-                candidates = expand_grid(self.param_grid)
-                if not candidates:
-                    raise ParameterError("PWARXSearch: param_grid leaves nothing to try")
-                table = self._run(base, candidates, u, yy, splits, "grid", bar)
-            else:
-                table = self._adaptive(base, order_grid, u, yy, splits, bar)
-        finally:
-            if bar is not None:
-                bar.close()
-        self.cv_results_ = table
-        self._rank(table)
-        self._choose_and_refit(base, table, u, yy, names, oname, splits)
+        # one BLAS/OpenMP thread in this process: every matrix here is small (tens of columns), and
+        # threaded BLAS on a busy machine spin-waits for cores (the polish's SVD of a 30,000 x 45
+        # Jacobian took 1.2 s with two threads beside another job, 0.02 s with one); parallelism
+        # belongs to the candidates (n_jobs), whose worker processes are single-threaded anyway
+        with threadpool_limits(limits=1):
+            try:
+                if self.param_grid is not None:
+                    candidates = expand_grid(self.param_grid)
+                    if not candidates:
+                        raise ParameterError("PWARXSearch: param_grid leaves nothing to try")
+                    table = self._run(base, candidates, u, yy, splits, "grid", bar)
+                else:
+                    table = self._adaptive(base, order_grid, u, yy, splits, bar)
+            finally:
+                if bar is not None:
+                    bar.close()
+            self.cv_results_ = table
+            self._rank(table)
+            self._choose_and_refit(base, table, u, yy, names, oname, splits)
         self.best_estimator_.sample_time_ = None if sample_time is None else float(sample_time)
         self.best_estimator_.units_ = {str(k): str(v) for k, v in dict(units or {}).items()}
         return self
