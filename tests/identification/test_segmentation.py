@@ -158,3 +158,38 @@ def test_same_seed_same_model():
     a = PWARX(2, 2, 1, n_regions=3, segmentation="alternating", random_state=7).fit(d.inputs, d.output)
     b = PWARX(2, 2, 1, n_regions=3, segmentation="alternating", random_state=7).fit(d.inputs, d.output)
     np.testing.assert_array_equal(a.theta_, b.theta_)
+
+
+@pytest.mark.parametrize("n, d, s", [(60, 1, 3), (500, 3, 4), (3000, 6, 8)])
+def test_compiled_alternation_matches_the_numpy_steps(n, d, s):
+    """The alternation's compiled loop takes the same steps as the array version: same labels,
+    objective and number of iterations (including the re-seeding of starving regions)."""
+    from hwpts.identification.segmentation.alternating import _alternate_numpy, alternate
+
+    rng = np.random.default_rng(n)
+    Z = rng.standard_normal((n, d))
+    Phi = np.hstack([Z, np.ones((n, 1))])
+    ys = np.where(Z[:, 0] > 0, Z @ rng.standard_normal(d), Z @ rng.standard_normal(d)) + 0.1 * rng.standard_normal(n)
+    start = rng.integers(0, s, n)
+    start[start == s - 1] = 0  # one region starts empty: the re-seeding runs
+    got, want = alternate(Phi, ys, Z, start, s), _alternate_numpy(Phi, ys, Z, start, s)
+    np.testing.assert_array_equal(got[0], want[0])
+    assert got[2] == want[2] and got[1] == pytest.approx(want[1], rel=1e-9)
+
+
+def test_warm_started_classifier_reaches_the_same_boundaries():
+    """A classifier started from a previous one (the refinement rounds' warm start) classifies as
+    the one fitted from zero, for binary and multinomial labels and on a subset of the columns."""
+    from hwpts.identification.partition import fit_linear_partition
+
+    rng = np.random.default_rng(3)
+    X = rng.standard_normal((4000, 3)) * [1.0, 5.0, 0.1] + [0.0, 10.0, 0.0]
+    for s, labels in ((2, (X[:, 0] > 0.2).astype(int)), (4, np.digitize(X[:, 0] + 0.2 * X[:, 1], [-1, 0, 1]))):
+        noisy = np.where(rng.random(4000) < 0.05, rng.integers(0, s, 4000), labels)
+        previous = fit_linear_partition(X[:2000], noisy[:2000], s)
+        for columns in (None, [0, 1]):
+            cold = fit_linear_partition(X[2000:], noisy[2000:], s, columns=columns)
+            warm = fit_linear_partition(X[2000:], noisy[2000:], s, columns=columns, init=previous)
+            assert np.mean(cold.predict(X) != warm.predict(X)) < 1e-3
+            np.testing.assert_allclose(warm.scores[0] - warm.scores[0][0], cold.scores[0] - cold.scores[0][0],
+                                       rtol=1e-3, atol=1e-3)

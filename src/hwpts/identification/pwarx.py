@@ -289,10 +289,12 @@ class PWARX(BaseEstimator):
             learner = PartitionLearner(refinement_rounds=self.refinement_rounds if seg.refine else 0,
                                        C=self.classifier_C, ridge=self.ridge, sparse=self.sparse_partition,
                                        random_state=self.random_state)
-            seg_labels = seg.labels
+            seg_labels, extension = seg.labels, None
             if X_seg is not X_reg:  # the segmentation saw a subsample: extend its labels to every row
-                seg_labels = fit_linear_partition(X_seg, seg.labels, s, C=self.classifier_C, columns=pcols).predict(X_reg)
-            _, partition, sparse_columns = learner.learn(X_reg, target, seg_labels, s, structure.constant, pcols)
+                extension = fit_linear_partition(X_seg, seg.labels, s, C=self.classifier_C, columns=pcols)
+                seg_labels = extension.predict(X_reg)
+            _, partition, sparse_columns = learner.learn(X_reg, target, seg_labels, s, structure.constant, pcols,
+                                                         init=extension)
             labels = partition.predict(X_reg)
             labels, s = drop_empty_regions(labels, partition.n_regions)
             if s != partition.n_regions:

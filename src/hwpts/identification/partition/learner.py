@@ -78,9 +78,10 @@ class PartitionLearner:
         self.trim = trim
         self.random_state = random_state
 
-    def learn(self, X, y, labels, s, constant=True, columns=None):
+    def learn(self, X, y, labels, s, constant=True, columns=None, init=None):
         """``(labels, partition, sparse_columns)`` for the rows ``X`` labelled ``labels``
         (``0 .. s-1``); ``columns``: regressor columns the classifier may use (default all);
+        ``init``: a classifier of these labels to start the first fit from (a warm start);
         ``sparse_columns`` is None unless the sparse step dropped some."""
         from hwpts.identification.local_models import fit_local_models
 
@@ -90,7 +91,7 @@ class PartitionLearner:
         # far more rows hardly move a logistic boundary and cost a Newton step each
         first = self._subsample(labels, s, rng)
         train_X, train_labels = X[first], labels[first]
-        partition = fit_linear_partition(train_X, train_labels, s, C=self.C, columns=columns)
+        partition = fit_linear_partition(train_X, train_labels, s, C=self.C, columns=columns, init=init)
         labels = partition.predict(X)
         rounds = self.refinement_rounds if s > 1 else 0
         p = X.shape[1] + 1
@@ -111,7 +112,8 @@ class PartitionLearner:
                 confident[:] = True
             confident = self._informative(confident, logp, rng)
             train_X, train_labels = X[confident], proposal[confident]
-            partition = fit_linear_partition(train_X, train_labels, s, C=self.C, columns=columns)
+            previous = partition if partition.n_regions == s else None
+            partition = fit_linear_partition(train_X, train_labels, s, C=self.C, columns=columns, init=previous)
             new_labels = partition.predict(X)
             if np.array_equal(new_labels, labels):
                 break
