@@ -217,3 +217,26 @@ def test_the_polish_restarts_its_free_run_at_every_break():
     _, across = polish_free_run(model.structure_, model.partition_, model.theta_, ("affine",), u, joined,
                                 center, half)
     assert across["initial_sse"] > 1.0
+
+
+@pytest.mark.parametrize("n", [300, 8000])
+def test_threshold_block_costs_are_the_least_squares_residuals(n):
+    """Every admissible block's cost is the residual sum of squares of least squares on its rows,
+    whether the normal equations are accumulated row by row (small data) or block by block."""
+    from hwpts.identification.segmentation import threshold as th
+
+    rng = np.random.default_rng(n)
+    X = rng.standard_normal((n, 2))
+    Phi = np.column_stack([X, np.ones(n)])
+    y = np.where(X[:, 0] > 0.3, X @ [1.0, 2.0], X @ [-1.0, 0.5]) + 0.1 * rng.standard_normal(n)
+    th._COST_CACHE.clear()
+    xs, nodes, cost, whole = th._split_costs(X[:, 0], Phi, y, 20, 50)
+    order = np.argsort(X[:, 0], kind="stable")
+    for i, j in [(0, 1), (0, nodes.size - 1), (nodes.size // 3, 2 * nodes.size // 3)]:
+        rows = order[nodes[i]:nodes[j]]
+        if rows.size < 20:
+            assert not np.isfinite(cost[i, j])
+            continue
+        residual = y[rows] - Phi[rows] @ np.linalg.lstsq(Phi[rows], y[rows], rcond=None)[0]
+        assert cost[i, j] == pytest.approx(residual @ residual, rel=1e-5)  # (a 1e-10 ridge)
+    assert whole == pytest.approx(cost[0, nodes.size - 1], rel=1e-12)

@@ -92,22 +92,19 @@ def _fingerprint(*arrays) -> bytes:
     return h.digest()
 
 
-def _split_costs(x, Phi, y, min_rows, n_grid):
+def _split_costs(x, Phi, y, min_rows, n_grid, data_key=None):
     """Sorted ``x``, the candidate block boundaries and the least-squares cost of every admissible
     block between two of them. They do not depend on the number of regions: a model search that
-    grows the regions on the same rows reuses them (a small cache keyed by the data's hash)."""
-    key = (_fingerprint(x, Phi, y), int(min_rows), int(n_grid))
+    grows the regions on the same rows reuses them (a small cache keyed by the data's hash;
+    ``data_key``: a fingerprint of ``(Phi, y)`` already computed, with ``x`` a column of ``Phi``
+    named in it, which spares hashing the rows again for every column)."""
+    key = (data_key if data_key is not None else _fingerprint(x, Phi, y), int(min_rows), int(n_grid))
     hit = _COST_CACHE.get(key)
     if hit is not None:
         return hit
     n, p = Phi.shape
     order = np.argsort(x, kind="stable")
-    xs, P, ys = x[order], Phi[order], y[order]
-    CG = np.concatenate([np.zeros((1, p, p)), np.cumsum(P[:, :, None] * P[:, None, :], axis=0)])
-    Cb = np.concatenate([np.zeros((1, p)), np.cumsum(P * ys[:, None], axis=0)])
-    Cy = np.concatenate([[0.0], np.cumsum(ys**2)])
-    ridge = 1e-10 * float(np.trace(CG[-1])) / p
-    whole = float(_block_sse(CG, Cb, Cy, np.array([0]), np.array([n]), ridge)[0])
+    xs = x[order]
     changes = np.flatnonzero(xs[1:] > xs[:-1]) + 1  # a cut at k splits rows [0, k) | [k, n)
     changes = changes[(changes >= min_rows) & (changes <= n - min_rows)]
     if n > EXACT_ROWS and changes.size > n_grid:
@@ -116,10 +113,25 @@ def _split_costs(x, Phi, y, min_rows, n_grid):
         changes = np.unique(changes)
     nodes = np.concatenate([[0], changes, [n]])  # block boundaries
     m = nodes.size
+    # normal equations accumulated at the block boundaries only: the sums over the rows between
+    # two consecutive boundaries (one product of the sorted rows each), then their running sums
+    Pw = np.column_stack([Phi[order], y[order]])
+    if 16 * m < n:
+        steps = np.zeros((m, p + 1, p + 1))
+        for j in range(m - 1):
+            block = Pw[nodes[j]:nodes[j + 1]]
+            steps[j + 1] = block.T @ block
+        C = np.cumsum(steps, axis=0)
+    else:  # few rows between boundaries (small data): running sums over the rows
+        C = np.concatenate([np.zeros((1, p + 1, p + 1)), np.cumsum(Pw[:, :, None] * Pw[:, None, :], axis=0)])[nodes]
+    CG, Cb, Cy = C[:, :p, :p], C[:, :p, p], C[:, p, p]
+    ridge = 1e-10 * float(np.trace(CG[-1])) / p
+    idx = np.arange(m)
+    whole = float(_block_sse(CG, Cb, Cy, idx[:1], idx[-1:], ridge)[0])
     ia, ib = np.triu_indices(m, k=1)
     ok = (nodes[ib] - nodes[ia]) >= min_rows
     cost = np.full((m, m), np.inf)
-    cost[ia[ok], ib[ok]] = _block_sse(CG, Cb, Cy, nodes[ia[ok]], nodes[ib[ok]], ridge)
+    cost[ia[ok], ib[ok]] = _block_sse(CG, Cb, Cy, ia[ok], ib[ok], ridge)
     out = (xs, nodes, cost, whole)
     if len(_COST_CACHE) >= _COST_CACHE_SIZE:
         _COST_CACHE.pop(next(iter(_COST_CACHE)))
@@ -127,13 +139,14 @@ def _split_costs(x, Phi, y, min_rows, n_grid):
     return out
 
 
-def optimal_split(x, Phi, y, n_regions, min_rows, n_grid=200):
+def optimal_split(x, Phi, y, n_regions, min_rows, n_grid=200, data_key=None):
     """Exact least-squares split of the rows into ``n_regions`` intervals of ``x`` (module doc).
 
     Returns ``(sse, thresholds)``; ``sse`` is ``inf`` when no admissible split exists.
+    ``data_key``: see :func:`_split_costs`.
     """
     xs, nodes, cost, whole = _split_costs(np.asarray(x, dtype=float), np.asarray(Phi, dtype=float),
-                                          np.asarray(y, dtype=float), min_rows, n_grid)
+                                          np.asarray(y, dtype=float), min_rows, n_grid, data_key)
     if n_regions == 1:
         return whole, []
     m = nodes.size
@@ -198,8 +211,10 @@ class ThresholdSegmenter(Segmenter):
         p = Phi.shape[1]
         min_rows = max(int(np.ceil(self.min_share * n)), p + 1)
         best = (np.inf, None, None)
+        rows = _fingerprint(Phi, y)  # once for every column (hashing the rows costs as much as a split)
         for c in columns:
-            sse, thresholds = optimal_split(X[:, c], Phi, y, n_regions, min_rows, int(self.n_grid))
+            sse, thresholds = optimal_split(X[:, c], Phi, y, n_regions, min_rows, int(self.n_grid),
+                                            data_key=(rows, c))
             if sse < best[0]:
                 best = (sse, c, thresholds)
         sse, c, thresholds = best
