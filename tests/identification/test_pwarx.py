@@ -311,3 +311,38 @@ def test_search_and_polish_run_blas_single_threaded(monkeypatch):
     PWARX(1, 1, 1, n_regions=2, segmentation="threshold", polish=True).fit(u, y)  # the polish alone too
     assert seen == [("polish", 1)]
     assert polish_free_run is polish_module.polish_free_run
+
+
+def test_classifier_rows_bound_the_region_classifiers_rows(monkeypatch):
+    """``classifier_rows`` caps the rows of every refinement classifier; the search's fold fits use
+    2,000 and its refit the estimator's own setting; a bad value is a ParameterError."""
+    import hwpts.identification.partition.learner as learner_module
+    from hwpts.identification import PWARXSearch
+
+    sizes = []
+    fit = learner_module.fit_linear_partition
+
+    def spy(X, *args, **kwargs):
+        sizes.append(X.shape[0])
+        return fit(X, *args, **kwargs)
+
+    monkeypatch.setattr(learner_module, "fit_linear_partition", spy)
+    d = make_system(5, rng=1, n=9000)
+    PWARX(2, 2, 1, n_regions=3, segmentation="alternating", classifier_rows=1500, random_state=0).fit(d.inputs, d.output)
+    assert sizes and max(sizes) <= 1500 + 200  # (a rare region keeps all its rows)
+    sizes.clear()
+    PWARX(2, 2, 1, n_regions=3, segmentation="alternating", random_state=0).fit(d.inputs, d.output)
+    assert max(sizes) > 2500  # default: 6,000
+    seen = []
+    original = learner_module.PartitionLearner.__init__
+
+    def record(self, **kwargs):
+        seen.append(kwargs.get("classifier_rows"))
+        original(self, **kwargs)
+
+    monkeypatch.setattr(learner_module.PartitionLearner, "__init__", record)
+    search = PWARXSearch(PWARX(2, 2, 1, random_state=0), {"segmentation": ["alternating"], "n_regions": [3]}, cv=2,
+                         try_polish=False).fit(d.inputs, d.output)
+    assert seen[:-1] == [2000, 2000] and seen[-1] is None and search.best_estimator_.classifier_rows is None
+    with pytest.raises(ParameterError, match="classifier_rows"):
+        PWARX(1, 1, 1, classifier_rows=10).fit(d.inputs, d.output)

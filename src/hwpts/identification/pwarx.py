@@ -97,6 +97,12 @@ class PWARX(BaseEstimator):
         the boundary refinement and the local least squares use every row. The segmentation's cost
         grows with the rows (default ``None``: all rows; :class:`PWARXSearch` uses 5,000 for its
         cross-validation fits, then refits the winner as given).
+    classifier_rows : int or None
+        Most rows each region classifier of a learned partition is fitted on (the boundary
+        refinement's rounds: half nearest the boundaries, half at random; default ``None``: 6,000,
+        :class:`~hwpts.identification.partition.PartitionLearner`'s). A multinomial Newton step costs
+        in proportion; :class:`PWARXSearch` uses 2,000 for its cross-validation fits, then refits the
+        winner as given.
     polish : bool
         Refine the local parameters by minimising the free-run simulation error on the training
         data (partition fixed; see :mod:`hwpts.identification.polish`), kept only if better.
@@ -151,7 +157,7 @@ class PWARX(BaseEstimator):
                  segmentation="clustering", hyperplanes=None, region_models=None, constant=True,
                  ridge=0.0, refinement_rounds=3, classifier_C=1e4, segmentation_params=None,
                  polish=False, partition_columns=None, sparse_partition=True, max_rows=None,
-                 random_state=None):
+                 classifier_rows=None, random_state=None):
         self.output_order = output_order
         self.input_order = input_order
         self.input_delay = input_delay
@@ -168,6 +174,7 @@ class PWARX(BaseEstimator):
         self.partition_columns = partition_columns
         self.sparse_partition = sparse_partition
         self.max_rows = max_rows
+        self.classifier_rows = classifier_rows
         self.random_state = random_state
 
     # ------------------------------------------------------------------ fitting
@@ -275,6 +282,9 @@ class PWARX(BaseEstimator):
         limit = self.max_rows
         if limit is not None and (isinstance(limit, bool) or not isinstance(limit, (int, np.integer)) or limit < 100):
             raise ParameterError(f"max_rows must be None or an int >= 100, got {limit!r}")
+        crows = self.classifier_rows
+        if crows is not None and (isinstance(crows, bool) or not isinstance(crows, (int, np.integer)) or crows < 100):
+            raise ParameterError(f"classifier_rows must be None or an int >= 100, got {crows!r}")
         if segmenter.learns_partition and limit is not None and X_reg.shape[0] > limit:
             rows = np.sort(rng.choice(X_reg.shape[0], int(limit), replace=False))
             X_seg, y_seg = X_reg[rows], target[rows]
@@ -286,9 +296,10 @@ class PWARX(BaseEstimator):
             partition = seg.partition
             labels = partition.predict(X_reg)
         else:
+            rows_kw = {} if self.classifier_rows is None else {"classifier_rows": self.classifier_rows}
             learner = PartitionLearner(refinement_rounds=self.refinement_rounds if seg.refine else 0,
                                        C=self.classifier_C, ridge=self.ridge, sparse=self.sparse_partition,
-                                       random_state=self.random_state)
+                                       random_state=self.random_state, **rows_kw)
             seg_labels, extension = seg.labels, None
             if X_seg is not X_reg:  # the segmentation saw a subsample: extend its labels to every row
                 extension = fit_linear_partition(X_seg, seg.labels, s, C=self.classifier_C, columns=pcols)
