@@ -193,3 +193,44 @@ def test_warm_started_classifier_reaches_the_same_boundaries():
             assert np.mean(cold.predict(X) != warm.predict(X)) < 1e-3
             np.testing.assert_allclose(warm.scores[0] - warm.scores[0][0], cold.scores[0] - cold.scores[0][0],
                                        rtol=1e-3, atol=1e-3)
+
+
+def test_clustering_features_are_reused_across_region_counts():
+    """The local features (nearest neighbours, local least squares) do not depend on the number of
+    regions: a second clustering of the same rows takes them from the cache, with the same labels."""
+    from hwpts.identification.segmentation import clustering
+
+    d = make_system(5, rng=2, n=1500)
+    structure = RegressorStructure.create(2, 2, 1, 2)
+    X, y = structure.build(d.inputs, d.output)
+    seg = make_segmenter("clustering")
+    clustering._FEATURE_CACHE.clear()
+    three = seg.segment(X, y, 3, structure, np.random.default_rng(0)).labels
+    assert len(clustering._FEATURE_CACHE) == 1
+    seg.segment(X, y, 4, structure, np.random.default_rng(0))
+    assert len(clustering._FEATURE_CACHE) == 1  # the same rows: reused
+    again = seg.segment(X, y, 3, structure, np.random.default_rng(0)).labels
+    clustering._FEATURE_CACHE.clear()
+    np.testing.assert_array_equal(again, three)
+    np.testing.assert_array_equal(seg.segment(X, y, 3, structure, np.random.default_rng(0)).labels, three)
+    seg.segment(X[:-1], y[:-1], 3, structure, np.random.default_rng(0))
+    assert len(clustering._FEATURE_CACHE) == 2  # other rows: computed
+
+
+def test_learned_partition_predicts_by_its_scores_as_its_polyhedra():
+    """A learned partition labels a row by the first largest classifier score, which is the first
+    polyhedron of eq. 9 containing it (checked against the inequalities on random rows)."""
+    from hwpts.identification.partition import fit_linear_partition
+
+    rng = np.random.default_rng(1)
+    for s in (2, 3, 7):
+        X = rng.standard_normal((5000, 4))
+        labels = np.argmax(X @ rng.standard_normal((4, s)), axis=1)
+        flip = rng.random(5000) < 0.1
+        labels[flip] = rng.integers(0, s, flip.sum())
+        partition = fit_linear_partition(X, labels, s)
+        fast = partition.predict(X)
+        v = partition.violations(X)
+        inside = v <= 0
+        np.testing.assert_array_equal(fast, np.argmax(inside, axis=1))
+        assert inside[np.arange(5000), fast].all()

@@ -91,7 +91,17 @@ class RegionPartition:
         return out
 
     def predict(self, X: np.ndarray) -> np.ndarray:
-        """Region index (0-based) of each regressor row: first polyhedron containing it (eq. 8)."""
+        """Region index (0-based) of each regressor row: first polyhedron containing it (eq. 8).
+
+        For a learned partition, whose region ``i`` is ``{x : s_i(x) >= s_j(x) for all j}``, that
+        is the first largest classifier score: ``s`` scores a row instead of ``s (s - 1)``
+        inequalities (the same region but where two scores tie to rounding)."""
+        if self.scores is not None and self.kind == "linear-classifier":
+            X = np.asarray(X, dtype=float)
+            if X.ndim != 2 or X.shape[1] != self.n_features:
+                raise DataError(f"regressors must have shape (n, {self.n_features}); got {X.shape}")
+            W, b = self.scores
+            return np.argmax(X @ W.T + b, axis=1).astype(np.int64)
         v = self.violations(X)
         inside = v <= 0.0
         first = np.argmax(inside, axis=1)

@@ -69,6 +69,18 @@ def standardize(X: np.ndarray) -> np.ndarray:
     return (X - X.mean(axis=0)) / sd
 
 
+def fingerprint(*arrays) -> bytes:
+    """A 16-byte hash of arrays' shapes, types and contents (keys of the segmenters' caches)."""
+    import hashlib
+
+    h = hashlib.blake2b(digest_size=16)
+    for a in arrays:
+        a = np.ascontiguousarray(a)
+        h.update(str((a.shape, a.dtype.str)).encode())
+        h.update(a.data)
+    return h.digest()
+
+
 def kmeans_labels(F: np.ndarray, n_clusters: int, rng, n_init: int = 10, sample_weight=None,
                   max_fit_samples: int = 4000) -> np.ndarray:
     """k-means labels of the rows of ``F``; centres fitted on a random subset of at most

@@ -20,11 +20,36 @@ from __future__ import annotations
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from hwpts.identification.segmentation.base import SegmentationResult, Segmenter, kmeans_labels, standardize
+from hwpts.identification.segmentation.base import (
+    SegmentationResult,
+    Segmenter,
+    fingerprint,
+    kmeans_labels,
+    standardize,
+)
+
+
+_FEATURE_CACHE: dict = {}  # fingerprint of (X, y, n_neighbors) -> local features (see local_features)
+_FEATURE_CACHE_SIZE = 24
 
 
 def local_features(X, y, n_neighbors: int):
-    """Local parameter vectors, mean regressors and residual variances (steps 1-3)."""
+    """Local parameter vectors, mean regressors and residual variances (steps 1-3).
+
+    They do not depend on the number of regions: a model search that grows the regions on the same
+    rows (the alternating method starts from this clustering) reuses them from a small cache keyed
+    by the rows' hash (the nearest-neighbour search is most of the clustering's cost)."""
+    key = (fingerprint(X, y), int(n_neighbors))
+    hit = _FEATURE_CACHE.get(key)
+    if hit is None:
+        hit = _local_features(X, y, n_neighbors)
+        if len(_FEATURE_CACHE) >= _FEATURE_CACHE_SIZE:
+            _FEATURE_CACHE.pop(next(iter(_FEATURE_CACHE)))
+        _FEATURE_CACHE[key] = hit
+    return tuple(a.copy() if isinstance(a, np.ndarray) else a for a in hit)
+
+
+def _local_features(X, y, n_neighbors: int):
     from sklearn.neighbors import NearestNeighbors
 
     Z = standardize(X)

@@ -26,7 +26,7 @@ import numpy as np
 
 from hwpts.errors import IdentificationError, ParameterError
 from hwpts.identification.partition import RegionPartition
-from hwpts.identification.segmentation.base import SegmentationResult, Segmenter
+from hwpts.identification.segmentation.base import SegmentationResult, Segmenter, fingerprint
 
 __all__ = ["ThresholdSegmenter", "threshold_partition"]
 
@@ -81,15 +81,7 @@ _COST_CACHE: dict = {}  # fingerprint of (x, Phi, y, min_rows, n_grid) -> block 
 _COST_CACHE_SIZE = 48
 
 
-def _fingerprint(*arrays) -> bytes:
-    import hashlib
-
-    h = hashlib.blake2b(digest_size=16)
-    for a in arrays:
-        a = np.ascontiguousarray(a)
-        h.update(str((a.shape, a.dtype.str)).encode())
-        h.update(a.data)
-    return h.digest()
+_fingerprint = fingerprint
 
 
 def _split_costs(x, Phi, y, min_rows, n_grid, data_key=None):
