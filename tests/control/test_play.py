@@ -20,8 +20,16 @@ def test_set_width_keeps_the_play_on_its_contact_edge():
     assert inv.effective == pytest.approx(2.75)
 
 
+# The estimator's mechanism is tested in the loop of an MPC that answers disturbances at the model
+# rate (the block-mean offset, two-sample moves: mpc's defaults before its fast disturbance
+# estimate). With the default mpc the last two speed samples correct most of a reversal's play
+# error within the model sample, the model-rate error then carries little of the valve's
+# direction, and the estimate moves little (measured on a +20 % play, 150 s: 0.251 V against the
+# true 0.30 V; RMS 0.338 % with or without it, well within the targets, as the 50-plant study shows).
+SLOW_MPC = dict(horizon=6, moves=3, offset_window=None, pump_latest=False)
+
+
 def _estimate(full_model_doc, width_factor, duration=150.0, adapt=True):
-    from hwpts.control.controllers import make_controller
     from hwpts.control.controllers.mpc import MPCController
     from hwpts.control.loop import run_loop
     from hwpts.control.scenarios import build_scenario
@@ -31,7 +39,7 @@ def _estimate(full_model_doc, width_factor, duration=150.0, adapt=True):
     sc = build_scenario("turbulence-a", seed=1, duration=duration)
     true = sc.parameters.hysteresis_half_width * width_factor
     sc.parameters = sc.parameters.replace(hysteresis_half_width=true)
-    c = make_controller("mpc", bank, r_hat, sc) if adapt else MPCController(bank, r_hat, adapt_width=False)
+    c = MPCController(bank, r_hat, adapt_width=adapt, **SLOW_MPC)
     result = run_loop(sc, c, seed=1)
     return c, true, r_hat, result, sc
 
