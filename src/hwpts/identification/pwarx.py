@@ -101,8 +101,7 @@ class PWARX(BaseEstimator):
         Most rows each region classifier of a learned partition is fitted on (the boundary
         refinement's rounds: half nearest the boundaries, half at random; default ``None``: 6,000,
         :class:`~hwpts.identification.partition.PartitionLearner`'s). A multinomial Newton step costs
-        in proportion; :class:`PWARXSearch` uses 2,000 for its cross-validation fits, then refits the
-        winner as given.
+        in proportion.
     polish : bool
         Refine the local parameters by minimising the free-run simulation error on the training
         data (partition fixed; see :mod:`hwpts.identification.polish`), kept only if better.
