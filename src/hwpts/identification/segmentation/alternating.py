@@ -128,6 +128,17 @@ def _alternate_kernel(Phi, ys, Z, labels, s, gamma, max_iter, ridge):  # pragma:
     return labels, it
 
 
+def _objective(Phi, ys, Z, labels, s, gamma, ridge, nf):
+    """The alternation's objective at ``labels``: mean squared residual plus gamma sigma^2 times the
+    mean squared distance to the region's feature centroid."""
+    theta = _fit_thetas(Phi, ys, labels, s, ridge)
+    R = (ys - np.einsum("ij,ij->i", Phi, theta[labels])) ** 2
+    cent = np.array([Z[labels == i].mean(axis=0) if np.any(labels == i) else Z[0] for i in range(s)])
+    D = ((Z - cent[labels]) ** 2).sum(axis=1) / nf
+    sigma2 = float(R.mean()) + 1e-12
+    return float(np.mean(R) + gamma * sigma2 * np.mean(D))
+
+
 def alternate(Phi, ys, Z, labels, s, gamma=1.0, max_iter=50, ridge=1e-8):
     """Run the alternation from ``labels``; returns (labels, objective, iterations)."""
     n, p = Phi.shape
@@ -135,13 +146,7 @@ def alternate(Phi, ys, Z, labels, s, gamma=1.0, max_iter=50, ridge=1e-8):
     labels, it = _alternate_kernel(np.ascontiguousarray(Phi, dtype=float), np.ascontiguousarray(ys, dtype=float),
                                    np.ascontiguousarray(Z, dtype=float), np.asarray(labels, dtype=np.int64),
                                    int(s), float(gamma), int(max_iter), float(ridge))
-    theta = _fit_thetas(Phi, ys, labels, s, ridge)
-    R = (ys - np.einsum("ij,ij->i", Phi, theta[labels])) ** 2
-    cent = np.array([Z[labels == i].mean(axis=0) if np.any(labels == i) else Z[0] for i in range(s)])
-    D = ((Z - cent[labels]) ** 2).sum(axis=1) / nf
-    sigma2 = float(R.mean()) + 1e-12
-    objective = float(np.mean(R) + gamma * sigma2 * np.mean(D))
-    return labels, objective, it
+    return labels, _objective(Phi, ys, Z, labels, s, gamma, ridge, nf), it
 
 
 def _alternate_numpy(Phi, ys, Z, labels, s, gamma=1.0, max_iter=50, ridge=1e-8):
@@ -172,13 +177,7 @@ def _alternate_numpy(Phi, ys, Z, labels, s, gamma=1.0, max_iter=50, ridge=1e-8):
         if np.array_equal(new, labels):
             break
         labels = new
-    theta = _fit_thetas(Phi, ys, labels, s, ridge)
-    R = (ys - np.einsum("ij,ij->i", Phi, theta[labels])) ** 2
-    cent = np.array([Z[labels == i].mean(axis=0) if np.any(labels == i) else Z[0] for i in range(s)])
-    D = ((Z - cent[labels]) ** 2).sum(axis=1) / nf
-    sigma2 = float(R.mean()) + 1e-12
-    objective = float(np.mean(R) + gamma * sigma2 * np.mean(D))
-    return labels, objective, it
+    return labels, _objective(Phi, ys, Z, labels, s, gamma, ridge, nf), it
 
 
 SUBSET = 4000  # rows used by the clustering start on large data sets
