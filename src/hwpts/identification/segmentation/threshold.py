@@ -81,16 +81,13 @@ _COST_CACHE: dict = {}  # fingerprint of (x, Phi, y, min_rows, n_grid) -> block 
 _COST_CACHE_SIZE = 48
 
 
-_fingerprint = fingerprint
-
-
 def _split_costs(x, Phi, y, min_rows, n_grid, data_key=None):
     """Sorted ``x``, the candidate block boundaries and the least-squares cost of every admissible
     block between two of them. They do not depend on the number of regions: a model search that
     grows the regions on the same rows reuses them (a small cache keyed by the data's hash;
     ``data_key``: a fingerprint of ``(Phi, y)`` already computed, with ``x`` a column of ``Phi``
     named in it, which spares hashing the rows again for every column)."""
-    key = (data_key if data_key is not None else _fingerprint(x, Phi, y), int(min_rows), int(n_grid))
+    key = (data_key if data_key is not None else fingerprint(x, Phi, y), int(min_rows), int(n_grid))
     hit = _COST_CACHE.get(key)
     if hit is not None:
         return hit
@@ -203,7 +200,7 @@ class ThresholdSegmenter(Segmenter):
         p = Phi.shape[1]
         min_rows = max(int(np.ceil(self.min_share * n)), p + 1)
         best = (np.inf, None, None)
-        rows = _fingerprint(Phi, y)  # once for every column (hashing the rows costs as much as a split)
+        rows = fingerprint(Phi, y)  # once for every column (hashing the rows costs as much as a split)
         for c in columns:
             sse, thresholds = optimal_split(X[:, c], Phi, y, n_regions, min_rows, int(self.n_grid),
                                             data_key=(rows, c))
