@@ -125,6 +125,24 @@ def test_search_reports_candidates_and_chooses_the_structure():
     assert fit_percent(v.output[2:], search.simulate(v.inputs, v.output).output[2:]) > 80
 
 
+def test_search_grows_past_ten_regions_while_the_held_out_fit_keeps_rising():
+    """A smooth map (y = sin 4x) is refined by every extra piece: the adaptive search goes past
+    REGION_CAP (10) while each count sets a new best held-out fit, and stops by itself."""
+    from hwpts.identification import PWARXSearch
+    from hwpts.identification.selection.search import REGION_CAP, REGION_HARD_CAP
+
+    rng = np.random.default_rng(0)
+    x = rng.uniform(-1, 1, (2000, 1))
+    y = np.sin(4 * x[:, 0]) + 0.001 * rng.standard_normal(2000)
+    search = PWARXSearch(PWARX(0, 1, 0, random_state=0), methods=("threshold",)).fit(x, y)
+    tried = max(r["params"]["n_regions"] for r in search.cv_results_)
+    assert search.best_estimator_.n_regions_ > REGION_CAP
+    assert REGION_CAP < tried < REGION_HARD_CAP
+    # an explicit max_regions is a hard limit
+    capped = PWARXSearch(PWARX(0, 1, 0, random_state=0), methods=("threshold",), max_regions=6).fit(x, y)
+    assert max(r["params"]["n_regions"] for r in capped.cv_results_) == 6
+
+
 def test_pwarx_is_one_model():
     """'auto' is not a segmentation: PWARX never selects among models."""
     d = make_system(5, rng=1, n=600)

@@ -23,7 +23,9 @@ Two ways to say what to try:
      of ``methods``; the count grows until ``patience`` successive counts improve neither the best
      free-run score nor the best held-out one-step fit (on a system whose free run is chaotic the
      free run alone cannot tell 3 regions from 6), or until every region would hold fewer than
-     ``3 p`` rows;
+     ``3 p`` rows; past 10 regions it goes on only while the held-out free-run fit itself keeps
+     setting new bests (``patience`` counts in a row without one stop it; at most 40 regions): a
+     smooth map approximated piece by piece asks for more pieces, a small one-step gain does not;
      Learned segmentations label at most 5,000 rows in these fits (``PWARX(max_rows=...)``).
      A candidate whose running mean over the blocks falls 10 points below the best so far is
      not scored on its remaining blocks (racing, Maron & Moore 1994): it could not win;
@@ -57,7 +59,8 @@ DEFAULT_METHODS = ("threshold", "alternating")
 ORDER_GRID = {"output_order": (0, 1, 2, 3, 4), "input_order": (1, 2, 3, 4), "input_delay": (1, 0)}
 ORDER_KEYS = ("output_order", "input_order", "input_delay")
 MIN_BLOCK = 10  # samples of a held-out block, beyond the initial conditions
-REGION_CAP = 10  # most regions the adaptive search tries (max_regions="auto")
+REGION_CAP = 10  # regions the adaptive search grows to by its usual rule (max_regions="auto") ...
+REGION_HARD_CAP = 40  # ... and at most beyond it, while each count sets a new best free-run fit
 PRUNE_MARGIN = 10.0  # points below the best so far at which a candidate's remaining blocks are skipped
 # a method trailing the leader of its region count by 2 points of free-run fit AND by 20 % in
 # one-step misfit (100 - fit), `patience` counts in a row, is not tried with more regions
@@ -170,8 +173,9 @@ class PWARXSearch(BaseEstimator):
     n_orders : int
         Orders carried from the ARX stage to the region stage.
     max_regions : int or "auto"
-        Largest number of regions tried ("auto": at most 10, and while the training rows hold
-        ``3 p`` rows a region for ``p`` parameters a mode).
+        Largest number of regions tried ("auto": 10, more while the held-out free-run fit keeps
+        rising, at most 40, and while the training rows hold ``3 p`` rows a region for ``p``
+        parameters a mode).
     patience : int
         Region counts in a row without a better score before the growth stops.
     tolerance : float
@@ -394,7 +398,7 @@ class PWARXSearch(BaseEstimator):
             best_one = max([r["mean_one_step_fit_percent"] or -np.inf for r in table if self._same_orders(r, orders)],
                            default=-np.inf)
             p = self._n_params(base, orders, u.shape[1])
-            top = min(n_train // (3 * p), REGION_CAP)
+            top = min(n_train // (3 * p), REGION_HARD_CAP)
             if self.max_regions != "auto":
                 top = min(n_train // (3 * p), int(self.max_regions))
             misses = 0
@@ -412,7 +416,17 @@ class PWARXSearch(BaseEstimator):
                 # grow while the free run or the one-step prediction improves: on a system whose
                 # free run is chaotic the held-out free-run fit cannot tell 3 regions from 5, while
                 # the one-step fit still sees the missing modes
-                if stage_best > best or stage_one > best_one:
+                if self.max_regions == "auto" and s >= REGION_CAP:
+                    # beyond REGION_CAP only while the held-out free-run fit keeps setting new
+                    # bests (a function the data keep refining, e.g. a smooth map approximated by
+                    # more and more pieces); a gain in one-step fit alone does not extend it
+                    if stage_best > best:
+                        best, best_one, misses = stage_best, max(best_one, stage_one), 0
+                    else:
+                        misses += 1
+                    if misses >= self.patience or (s == REGION_CAP and misses > 0):
+                        break
+                elif stage_best > best or stage_one > best_one:
                     best, best_one, misses = max(best, stage_best), max(best_one, stage_one), 0
                 else:
                     misses += 1
