@@ -241,6 +241,20 @@ def test_cli_segmentation_names_match_the_registry():
     assert sorted(SEGMENTATION_NAMES) == sorted(SEGMENTATION_METHODS)
 
 
+def test_identify_help_names_the_methods_auto_chooses_among(capsys):
+    """The help of --segmentation names the search's default methods (it named clustering too,
+    which the default search does not try)."""
+    from hwpts.cli import main
+    from hwpts.identification.selection import DEFAULT_METHODS
+
+    try:
+        main(["identify", "--help"])
+    except SystemExit:
+        pass
+    text = " ".join(capsys.readouterr().out.split())
+    assert "chosen on the data among " + " and ".join(DEFAULT_METHODS) + ";" in text
+
+
 def test_help_does_not_import_the_numerical_libraries():
     import subprocess
     import sys

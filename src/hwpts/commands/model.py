@@ -477,8 +477,8 @@ def register(subparsers):
     p.add_argument("--nk", default=None, metavar="N",
                    help="input delay, 0 uses u(k) (default: chosen on the data, 0-1; 1 when --na and --nb are given)")
     p.add_argument("--segmentation", choices=["auto", *SEGMENTATION_NAMES], default=None,
-                   help="segmentation method (default auto: chosen on the data among threshold, clustering and "
-                        "alternating; hyperplane when --hyperplane is given)")
+                   help="segmentation method (default auto: chosen on the data among threshold and alternating; "
+                        "hyperplane when --hyperplane is given)")
     p.add_argument("--regions", default="auto", metavar="S",
                    help="number of regions (default auto: grown while the held-out fit improves)")
     p.add_argument("--hyperplane", action="append", default=[], metavar='"a,b,c"',
