@@ -225,6 +225,29 @@ def test_search_bad_inputs_give_one_line(tmp_path, data_csv, capsys):
                            "--out", str(out)], "n_regions=50 is too many for 298 regressor rows", out)
 
 
+def test_regions_given_method_auto_chooses_among_the_default_methods(tmp_path, data_csv, capsys):
+    """--regions S without --segmentation: each default method with S regions is scored on the
+    held-out blocks (it fitted the library's clustering before, and with the orders left open it
+    stopped on "segmentation 'auto' is a model search")."""
+    from hwpts.identification.selection import DEFAULT_METHODS
+
+    out = tmp_path / "m.json"
+    assert main(["identify", str(data_csv), *IDENTIFY, "--regions", "3", "--out", str(out)]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["segmentation"] in DEFAULT_METHODS
+    assert sorted(r["segmentation"] for r in summary["candidates"] if r["stage"] == "grid") == sorted(DEFAULT_METHODS)
+    assert {r["n_regions"] for r in summary["candidates"]} == {3}
+    rows = tmp_path / "short.csv"
+    d = make_system(5, rng=0, n=400)
+    write_csv(rows, {"u1": d.inputs[:, 0], "u2": d.inputs[:, 1], "y": d.output})
+    assert main(["identify", str(rows), "--input", "u1", "--input", "u2", "--output", "y", "--regions", "2",
+                 "--out", str(out)]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["segmentation"] in DEFAULT_METHODS and summary["n_regions"] == 2
+    assert main(["identify", str(data_csv), *IDENTIFY, "--regions", "1", "--out", str(out)]) == 0
+    assert json.loads(capsys.readouterr().out)["segmentation"] == "average"
+
+
 def test_hyperplane_with_a_negative_first_coefficient(tmp_path, data_csv, capsys):
     """The documented form for a negative first coefficient: --hyperplane=-1,0,0.2."""
     out = tmp_path / "m.json"

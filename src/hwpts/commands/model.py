@@ -216,6 +216,7 @@ def cmd_identify(args) -> int:
     from hwpts.identification.partition import Hyperplane
     from hwpts.identification.regressors import RegressorStructure
     from hwpts.identification.selection import DEFAULT_METHODS
+    from hwpts.identification.selection.search import METHOD_PARAMS
     from hwpts.io.models import save_model
 
     data, dt = _load_dataset(args.data, args.input, args.output, args.time, args.rows)
@@ -264,7 +265,18 @@ def cmd_identify(args) -> int:
         partition_columns=args.partition_column or None, sparse_partition=not args.all_partition_columns,
     )
     search = None
-    if searched or (n_regions == "auto" and not fixed_partition):
+    if segmentation == "auto" and n_regions == 1:  # one region: a single ARX model, no method to choose
+        model.set_params(segmentation="average")
+        if searched:
+            search = PWARXSearch(model, param_grid=dict(searched), progress=True,
+                                 try_polish="auto" if not args.polish else False)
+    elif segmentation == "auto" and isinstance(n_regions, int):
+        # the count given, the method chosen: each of the default methods with that count (and the
+        # orders left open) scored on the held-out blocks, as the adaptive search would
+        grid = [{**searched, "segmentation": [m], "n_regions": [n_regions],
+                 "segmentation_params": [METHOD_PARAMS.get(m)]} for m in DEFAULT_METHODS]
+        search = PWARXSearch(model, param_grid=grid, progress=True, try_polish="auto" if not args.polish else False)
+    elif searched or (n_regions == "auto" and not fixed_partition):
         if segmentation == "auto" or n_regions == "auto" and not fixed_partition:
             methods = DEFAULT_METHODS if segmentation == "auto" else (segmentation,)
             search = PWARXSearch(model, methods=methods, orders=searched or None, progress=True,
