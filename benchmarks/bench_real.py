@@ -147,8 +147,12 @@ def main(argv=None) -> int:
                     score = _score(cfg, tests[test][1], yh, max(n_init, 3))
                     print(f"{'  PyPARC K=3':19s} {test:10s} {'':8s} {score:8.2f} {'':7s} {'':4s} {info['fit_time_s']:8.1f}"
                           f"  na 2 nb 3 nk 0 (its fit only; hwpts's time includes choosing orders, method, regions)")
-                print(f"    speed: hwpts default {elapsed:.1f} s vs one PyPARC fit {info['fit_time_s']:.1f} s: "
-                      f"{info['fit_time_s'] / elapsed:.2f}x (target >= 3x)", flush=True)
+                # PyPARC fits the same training data once per test record: the ratio is taken
+                # against its fastest fit (the harder comparison for hwpts)
+                times = [info["fit_time_s"] for _, info in res.values()]
+                print(f"    speed: hwpts default {elapsed:.1f} s vs one PyPARC fit {min(times):.1f} s (fastest of "
+                      f"{len(times)}: {', '.join(f'{t:.1f}' for t in times)} s): {min(times) / elapsed:.2f}x "
+                      f"(target >= 3x)", flush=True)
     print("targets met: " + ", ".join(f"{n}/{t}: {'yes' if m else 'no'}" for n, t, m in status_lines))
     return 0
 
