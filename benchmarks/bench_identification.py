@@ -35,18 +35,26 @@ import numpy as np
 
 HERE = Path(__file__).resolve().parent
 PYPARC_VENV = HERE / ".venv-pyparc"
-PYPARC_PACKAGES = ["pycddlib<3", "pypoman<1.1", "scikit-learn<1.8", "pyparc"]
+# numpy < 2.4: PyPARC 2.0.4 writes a one-element array into a scalar slot for K = 2 (parc.py,
+# fit_PWL: gamma1[0] = -intercept_), which numpy 2.4 refuses ("setting an array element with a
+# sequence"): with it the zoo's two 2-region systems had no PyPARC row
+PYPARC_PACKAGES = ["numpy<2.4", "pycddlib<3", "pypoman<1.1", "scikit-learn<1.8", "pyparc"]
+PYPARC_CHECK = ("import sys, numpy, pyparc.parc; "
+                "sys.exit(0 if tuple(int(x) for x in numpy.__version__.split('.')[:2]) < (2, 4) else 1)")
 
 
 def _pyparc_python() -> tuple[Path | None, str | None]:
-    """The PyPARC interpreter, creating the venv on demand; (None, reason) if impossible."""
+    """The PyPARC interpreter, creating the venv (or bringing its packages to PYPARC_PACKAGES) on
+    demand; (None, reason) if impossible."""
     py = PYPARC_VENV / "bin" / "python"
-    check = [str(py), "-c", "import pyparc.parc"]
+    check = [str(py), "-c", PYPARC_CHECK]
     if py.exists() and subprocess.run(check, capture_output=True).returncode == 0:
         return py, None
-    print(f"creating {PYPARC_VENV.name} and installing {' '.join(PYPARC_PACKAGES)} ...", flush=True)
+    print(f"{'updating' if py.exists() else 'creating'} {PYPARC_VENV.name}: installing {' '.join(PYPARC_PACKAGES)} ...",
+          flush=True)
     try:
-        subprocess.run([sys.executable, "-m", "venv", str(PYPARC_VENV)], check=True, capture_output=True)
+        if not py.exists():
+            subprocess.run([sys.executable, "-m", "venv", str(PYPARC_VENV)], check=True, capture_output=True)
         proc = subprocess.run([str(py), "-m", "pip", "install", "--quiet", *PYPARC_PACKAGES],
                               capture_output=True, text=True, timeout=1800)
     except (subprocess.SubprocessError, OSError) as error:
@@ -56,7 +64,8 @@ def _pyparc_python() -> tuple[Path | None, str | None]:
         return None, "pip install failed: " + " | ".join(tail)
     probe = subprocess.run(check, capture_output=True, text=True)
     if probe.returncode != 0:
-        return None, "pyparc installed but does not import: " + probe.stderr.strip().splitlines()[-1]
+        why = probe.stderr.strip().splitlines()[-1:] or ["numpy is still >= 2.4"]
+        return None, "pyparc installed but not usable: " + why[0]
     return py, None
 
 
