@@ -265,22 +265,24 @@ def cmd_identify(args) -> int:
         partition_columns=args.partition_column or None, sparse_partition=not args.all_partition_columns,
     )
     search = None
+    # the search scores the winner with the polish too, unless --polish already polishes every candidate
+    try_polish = "auto" if not args.polish else False
     if segmentation == "auto" and n_regions == 1:  # one region: a single ARX model, no method to choose
         model.set_params(segmentation="average")
         if searched:
             search = PWARXSearch(model, param_grid=dict(searched), progress=True,
-                                 try_polish="auto" if not args.polish else False)
+                                 try_polish=try_polish)
     elif segmentation == "auto" and isinstance(n_regions, int):
         # the count given, the method chosen: each of the default methods with that count (and the
         # orders left open) scored on the held-out blocks, as the adaptive search would
         grid = [{**searched, "segmentation": [m], "n_regions": [n_regions],
                  "segmentation_params": [METHOD_PARAMS.get(m)]} for m in DEFAULT_METHODS]
-        search = PWARXSearch(model, param_grid=grid, progress=True, try_polish="auto" if not args.polish else False)
+        search = PWARXSearch(model, param_grid=grid, progress=True, try_polish=try_polish)
     elif searched or (n_regions == "auto" and not fixed_partition):
         if segmentation == "auto" or n_regions == "auto" and not fixed_partition:
             methods = DEFAULT_METHODS if segmentation == "auto" else (segmentation,)
             search = PWARXSearch(model, methods=methods, orders=searched or None, progress=True,
-                                 try_polish="auto" if not args.polish else False,
+                                 try_polish=try_polish,
                                  max_regions=n_regions if isinstance(n_regions, int) else "auto")
             if isinstance(n_regions, int):  # a fixed method and count, the orders searched
                 search.set_params(param_grid={**searched, "segmentation": [segmentation], "n_regions": [n_regions]})
