@@ -81,6 +81,26 @@ def fingerprint(*arrays) -> bytes:
     return h.digest()
 
 
+class BoundedCache(dict):
+    """A small first-in-first-out cache (the segmenters' costs that do not depend on the number of
+    regions, keyed by :func:`fingerprint` of their rows): at most ``maxsize`` entries."""
+
+    def __init__(self, maxsize: int):
+        super().__init__()
+        self.maxsize = int(maxsize)
+
+    def get_or_compute(self, key, compute):
+        """The value stored under ``key``, or ``compute()`` stored there (the oldest entry dropped
+        when full)."""
+        hit = self.get(key)
+        if hit is None:
+            hit = compute()
+            if len(self) >= self.maxsize:
+                self.pop(next(iter(self)))
+            self[key] = hit
+        return hit
+
+
 def kmeans_labels(F: np.ndarray, n_clusters: int, rng, n_init: int = 10, sample_weight=None,
                   max_fit_samples: int = 4000) -> np.ndarray:
     """k-means labels of the rows of ``F``; centres fitted on a random subset of at most

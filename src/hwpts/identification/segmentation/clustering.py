@@ -21,6 +21,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from hwpts.identification.segmentation.base import (
+    BoundedCache,
     SegmentationResult,
     Segmenter,
     fingerprint,
@@ -29,8 +30,7 @@ from hwpts.identification.segmentation.base import (
 )
 
 
-_FEATURE_CACHE: dict = {}  # fingerprint of (X, y, n_neighbors) -> local features (see local_features)
-_FEATURE_CACHE_SIZE = 24
+_FEATURE_CACHE = BoundedCache(24)  # fingerprint of (X, y), n_neighbors -> local features (see local_features)
 
 
 def local_features(X, y, n_neighbors: int):
@@ -40,12 +40,7 @@ def local_features(X, y, n_neighbors: int):
     rows (the alternating method starts from this clustering) reuses them from a small cache keyed
     by the rows' hash (the nearest-neighbour search is most of the clustering's cost)."""
     key = (fingerprint(X, y), int(n_neighbors))
-    hit = _FEATURE_CACHE.get(key)
-    if hit is None:
-        hit = _local_features(X, y, n_neighbors)
-        if len(_FEATURE_CACHE) >= _FEATURE_CACHE_SIZE:
-            _FEATURE_CACHE.pop(next(iter(_FEATURE_CACHE)))
-        _FEATURE_CACHE[key] = hit
+    hit = _FEATURE_CACHE.get_or_compute(key, lambda: _local_features(X, y, n_neighbors))
     return tuple(a.copy() if isinstance(a, np.ndarray) else a for a in hit)
 
 

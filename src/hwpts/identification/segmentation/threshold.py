@@ -26,7 +26,7 @@ import numpy as np
 
 from hwpts.errors import IdentificationError, ParameterError
 from hwpts.identification.partition import RegionPartition
-from hwpts.identification.segmentation.base import SegmentationResult, Segmenter, fingerprint
+from hwpts.identification.segmentation.base import BoundedCache, SegmentationResult, Segmenter, fingerprint
 
 __all__ = ["ThresholdSegmenter", "threshold_partition"]
 
@@ -77,8 +77,7 @@ def _block_sse(CG, Cb, Cy, a, b, ridge):
     return np.maximum(yy - np.einsum("ni,ni->n", r, theta), 0.0)
 
 
-_COST_CACHE: dict = {}  # fingerprint of (x, Phi, y, min_rows, n_grid) -> block costs (see _split_costs)
-_COST_CACHE_SIZE = 48
+_COST_CACHE = BoundedCache(48)  # fingerprint of (x, Phi, y), min_rows, n_grid -> block costs (see _split_costs)
 
 
 def _split_costs(x, Phi, y, min_rows, n_grid, data_key=None):
@@ -88,9 +87,11 @@ def _split_costs(x, Phi, y, min_rows, n_grid, data_key=None):
     ``data_key``: a fingerprint of ``(Phi, y)`` already computed, with ``x`` a column of ``Phi``
     named in it, which spares hashing the rows again for every column)."""
     key = (data_key if data_key is not None else fingerprint(x, Phi, y), int(min_rows), int(n_grid))
-    hit = _COST_CACHE.get(key)
-    if hit is not None:
-        return hit
+    return _COST_CACHE.get_or_compute(key, lambda: _block_costs(x, Phi, y, min_rows, n_grid))
+
+
+def _block_costs(x, Phi, y, min_rows, n_grid):
+    """What :func:`_split_costs` returns, computed."""
     n, p = Phi.shape
     order = np.argsort(x, kind="stable")
     xs = x[order]
@@ -121,11 +122,7 @@ def _split_costs(x, Phi, y, min_rows, n_grid, data_key=None):
     ok = (nodes[ib] - nodes[ia]) >= min_rows
     cost = np.full((m, m), np.inf)
     cost[ia[ok], ib[ok]] = _block_sse(CG, Cb, Cy, ia[ok], ib[ok], ridge)
-    out = (xs, nodes, cost, whole)
-    if len(_COST_CACHE) >= _COST_CACHE_SIZE:
-        _COST_CACHE.pop(next(iter(_COST_CACHE)))
-    _COST_CACHE[key] = out
-    return out
+    return xs, nodes, cost, whole
 
 
 def optimal_split(x, Phi, y, n_regions, min_rows, n_grid=200, data_key=None):
