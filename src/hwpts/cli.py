@@ -95,7 +95,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     SIGTERM is handled as Ctrl-C: the run stops, temporary files and staging folders are removed,
     earlier outputs stay intact, exit status 130 and one line.
     """
-    parser = build_parser()
     previous: dict = {}
     hook = sys.unraisablehook
     _INTERRUPTED.clear()
@@ -104,7 +103,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             previous[sig] = signal.signal(sig, _interrupt)
         sys.unraisablehook = _quiet_interrupts(hook)
     try:
-        return _run(parser, argv)
+        return _run(argv)
     finally:
         for sig, handler in previous.items():
             signal.signal(sig, handler)
@@ -112,10 +111,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         _INTERRUPTED.clear()
 
 
-def _run(parser: ArgumentParser, argv: Sequence[str] | None) -> int:
-    """Parse and dispatch; every failure becomes one line and an exit status."""
+def _run(argv: Sequence[str] | None) -> int:
+    """Parse and dispatch; every failure becomes one line and an exit status. The parser is built
+    here, after the signal handlers are in place: building it imports the command modules (numpy
+    and more), and a Ctrl-C or SIGTERM in that time is an interrupt like any other."""
     try:
-        args = parser.parse_args(argv)
+        args = build_parser().parse_args(argv)
         args.command_line = shlex.join(["hwpts", *(sys.argv[1:] if argv is None else argv)])
         _check_outputs(args)
         status = int(args.handler(args) or EXIT_OK)

@@ -128,6 +128,22 @@ def test_an_interrupt_swallowed_by_a_library_is_still_an_interrupt(monkeypatch, 
     assert capsys.readouterr().err == "hwpts: interrupted\n"
 
 
+def test_an_interrupt_while_the_parser_is_built_is_an_interrupt(monkeypatch, capsys):
+    # building the parser imports every command module (numpy and more): a Ctrl-C in that time
+    # must already find the handlers in place, not end in a KeyboardInterrupt traceback
+    import hwpts.cli as cli
+
+    def slow_import():
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(1.0)  # the handler raises KeyboardInterrupt here
+        raise AssertionError("the signal was not delivered")
+
+    monkeypatch.setattr(cli, "build_parser", slow_import)
+    assert cli.main(["reproduce", "--quick"]) == 130
+    assert capsys.readouterr().err == "hwpts: interrupted\n"
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # restored after the run
+
+
 def test_no_output_is_committed_after_an_interrupt(tmp_path, monkeypatch, capsys):
     from hwpts.io.atomic import INTERRUPTED, write_text_atomic
     from hwpts.io.folders import staged_folder
