@@ -17,6 +17,7 @@ from collections.abc import Sequence
 
 from hwpts import __version__
 from hwpts.errors import HwptsError, UsageError
+from hwpts.io.atomic import COMMITTING as _COMMITTING
 from hwpts.io.atomic import INTERRUPTED as _INTERRUPTED  # set by SIGINT/SIGTERM (stdlib only: --help stays fast)
 
 EXIT_OK = 0
@@ -72,6 +73,8 @@ def _check_outputs(args) -> None:
 
 def _interrupt(signum, frame):  # pragma: no cover - exercised in a subprocess test
     _INTERRUPTED.set()
+    if _COMMITTING.is_set():  # inside a commit: recorded, raised by no one (the commit completes)
+        return
     raise KeyboardInterrupt
 
 

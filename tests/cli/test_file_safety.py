@@ -169,6 +169,40 @@ def test_no_output_is_committed_after_an_interrupt(tmp_path, monkeypatch, capsys
     assert _run_with_handler(monkeypatch, lambda args: write_text_atomic(out, "{}")) == 0 and out.exists()
 
 
+def test_a_signal_inside_the_folder_swap_lets_the_swap_complete(tmp_path, monkeypatch, capsys):
+    # the earlier folder is moved aside, then the new one moved in: a Ctrl-C between the two
+    # used to leave no folder at --out (and the next run deleted the one moved aside)
+    from hwpts.io.atomic import INTERRUPTED
+    from hwpts.io.folders import staged_folder
+
+    out = tmp_path / "results"
+    out.mkdir()
+    (out / "summary.json").write_text('{"schema": "test/1", "run": 1}')
+    real_replace = os.replace
+    calls = []
+
+    def replace_then_signal(src, dst):
+        real_replace(src, dst)
+        calls.append(dst)
+        if len(calls) == 1:  # the earlier folder is aside, the new one not yet in place
+            os.kill(os.getpid(), signal.SIGINT)
+
+    def handler(args):
+        with staged_folder(out, "test/1") as stage:
+            (stage / "summary.json").write_text('{"schema": "test/1", "run": 2}')
+        monkeypatch.setattr(os, "replace", real_replace)
+
+    def patched(args):
+        monkeypatch.setattr(os, "replace", replace_then_signal)
+        return handler(args)
+
+    assert _run_with_handler(monkeypatch, patched) == 0  # the commit completed: the run finished
+    assert len(calls) == 2
+    assert json.loads((out / "summary.json").read_text())["run"] == 2
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["results"]
+    assert not INTERRUPTED.is_set()
+
+
 def test_a_killed_runs_staging_folder_is_removed_by_the_next_run(tmp_path):
     from hwpts.io.folders import PID_FILE, staged_folder
 

@@ -19,6 +19,25 @@ INTERRUPTED = threading.Event()
 """Set by the command line's SIGINT/SIGTERM handler: no output is committed once it is set."""
 
 
+COMMITTING = threading.Event()
+"""Set while a commit runs (:func:`point_of_no_return`): the handler then records a signal
+without raising it."""
+
+
+@contextlib.contextmanager
+def point_of_no_return():
+    """The steps of a commit that must all happen once begun (a folder moved aside and its
+    replacement moved in): a SIGINT/SIGTERM arriving inside is recorded in :data:`INTERRUPTED` but
+    not raised, so the commit completes instead of leaving the target missing; a later
+    :func:`commit_allowed` still refuses the next output. The first step inside should be
+    :func:`commit_allowed` (a signal that came before the commit began stops it)."""
+    COMMITTING.set()
+    try:
+        yield
+    finally:
+        COMMITTING.clear()
+
+
 def commit_allowed() -> None:
     """Raise ``KeyboardInterrupt`` if the run was interrupted (an interrupt swallowed by a library
     callback must not let the run write its outputs after the user asked it to stop)."""
@@ -98,9 +117,10 @@ def atomic_path(path: str | os.PathLike, suffix: str | None = None):
         raise DataError(f"--out {str(target)!r}: cannot write there ({error.strerror or error})") from None
     try:
         yield Path(tmp)
-        commit_allowed()
-        os.chmod(tmp, umask_mode())
-        os.replace(tmp, target)
+        with point_of_no_return():
+            commit_allowed()
+            os.chmod(tmp, umask_mode())
+            os.replace(tmp, target)
     except OSError as error:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)

@@ -11,7 +11,7 @@ import tempfile
 from pathlib import Path
 
 from hwpts.errors import DataError
-from hwpts.io.atomic import commit_allowed, umask_mode
+from hwpts.io.atomic import commit_allowed, point_of_no_return, umask_mode
 
 
 def check_replaceable(path: str | os.PathLike, schema: str, marker: str = "summary.json") -> None:
@@ -70,17 +70,24 @@ def staged_folder(path: str | os.PathLike, schema: str):
         raise DataError(f"--out {str(out)!r}: cannot write there ({error.strerror or error})") from None
     try:
         yield stage
-        commit_allowed()
-        (stage / PID_FILE).unlink()
-        os.chmod(stage, umask_mode(0o777))
     except BaseException:
         shutil.rmtree(stage, ignore_errors=True)
         raise
-    old = None
-    if out.exists():
-        old = Path(tempfile.mkdtemp(prefix=f".{out.name}.old-", dir=out.parent))
-        os.rmdir(old)
-        os.replace(out, old)
-    os.replace(stage, out)
-    if old is not None:
-        shutil.rmtree(old, ignore_errors=True)
+    # the target is moved aside and the stage moved in as one step: a signal in between would
+    # leave no folder at `out` (and the next run would delete the one moved aside)
+    with point_of_no_return():
+        try:
+            commit_allowed()
+            (stage / PID_FILE).unlink()
+            os.chmod(stage, umask_mode(0o777))
+        except BaseException:
+            shutil.rmtree(stage, ignore_errors=True)
+            raise
+        old = None
+        if out.exists():
+            old = Path(tempfile.mkdtemp(prefix=f".{out.name}.old-", dir=out.parent))
+            os.rmdir(old)
+            os.replace(out, old)
+        os.replace(stage, out)
+        if old is not None:
+            shutil.rmtree(old, ignore_errors=True)
