@@ -1,0 +1,176 @@
+"""Where the identification targets meet the limits of the data, measured.
+
+Two questions the zoo and real-data benchmarks leave open, answered with numbers:
+
+1. **Boundaries learned from samples** (every PWA system of ``../shared/benchmarks/pwarx_zoo.py``):
+   the oracle of the zoo knows the true partition at validation time. Here every training
+   sample's true mode and the oracle's parameters are given, and only the partition is learned
+   from the labelled training samples, by three classifiers of different kinds: hwpts's
+   multinomial logistic classifier (``fit_linear_partition``, what the library uses), pairwise
+   linear SVMs voting one against one (a max-margin boundary per pair of modes), and the nearest
+   training sample (no linear boundary at all). Whatever the classifier, a validation sample that
+   falls between the last training sample of one mode and the first of another can land on either
+   side; on a discontinuous map that costs the jump. The median one-step fit over the seeds is
+   what an estimator that found every mode and every parameter exactly would still get.
+2. **Silverbox's arrow record is partly an extrapolation test**: the default search's model
+   (orders and everything chosen on the training part) has its arrow error split between the
+   samples near outputs beyond the training record's range and the rest.
+
+``python -m benchmarks limits [--seeds N] [--systems a,b] [--no-silverbox]``
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+import warnings
+
+import numpy as np
+
+DEFAULT_SEEDS = 10
+NEAR = 100  # samples on either side of an output beyond the training range count as "near" it
+
+
+def _pairwise_svm(Z, labels, Zv, n_modes, C=1e4):
+    """One-vs-one linear SVM votes (scikit-learn LinearSVC per pair of modes)."""
+    from sklearn.svm import LinearSVC
+
+    votes = np.zeros((Zv.shape[0], n_modes))
+    for i in range(n_modes):
+        for j in range(i + 1, n_modes):
+            sel = (labels == i) | (labels == j)
+            if not np.any(labels == i) or not np.any(labels == j):
+                continue
+            clf = LinearSVC(C=C, max_iter=50_000, tol=1e-6).fit(Z[sel], (labels[sel] == i).astype(int))
+            first = clf.predict(Zv)
+            votes[:, i] += first
+            votes[:, j] += 1 - first
+    return np.argmax(votes, axis=1)
+
+
+def boundary_limits(zoo, names, seeds):
+    """Per system: median oracle fit and, per classifier, median one-step fit, region accuracy and
+    misclassified validation samples, with the partition learned from the true training modes."""
+    from sklearn.neighbors import KNeighborsClassifier
+    from sklearn.preprocessing import StandardScaler
+
+    from benchmarks.bench_zoo import one_step_fit, oracle_theta, validation_n
+    from hwpts.identification.partition import fit_linear_partition
+
+    out = {}
+    for name in names:
+        gen, _ = zoo.SYSTEMS[name]
+        kw = {"n": 20000} if name == "pwarx_random" else {}
+        rows = {k: {"fit": [], "acc": [], "wrong": []} for k in ("oracle", "logistic", "svm", "nearest")}
+        for seed in seeds:
+            d = gen(rng=seed, **kw)
+            v = gen(n=validation_n(d), sigma=0.0, rng=10_000 + seed)
+            Phi, _, M = d.regressors()
+            Phi_v, Y_v, M_v = v.regressors()
+            ok, ok_v = M >= 0, M_v >= 0
+            Phi, M = Phi[ok], M[ok]
+            Phi_v, Y_v, M_v = Phi_v[ok_v], Y_v[ok_v], M_v[ok_v]
+            theta = oracle_theta(zoo, d)
+            A_v = np.column_stack([Phi_v, np.ones(len(Phi_v))])
+            scaler = StandardScaler().fit(Phi)
+            Z, Zv = scaler.transform(Phi), scaler.transform(Phi_v)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                labels = {
+                    "oracle": d.region_fn(Phi_v),
+                    "logistic": fit_linear_partition(Phi, M, d.n_modes).predict(Phi_v),
+                    "svm": _pairwise_svm(Z, M, Zv, d.n_modes),
+                    "nearest": KNeighborsClassifier(1).fit(Z, M).predict(Zv),
+                }
+            for key, lab in labels.items():
+                yhat = np.einsum("ij,ij->i", A_v, theta[lab])
+                rows[key]["fit"].append(one_step_fit(Y_v, yhat))
+                rows[key]["acc"].append(100.0 * np.mean(lab == M_v))
+                rows[key]["wrong"].append(int(np.sum(lab != M_v)))
+        out[name] = {k: {m: float(np.median(v)) for m, v in r.items()} for k, r in rows.items()}
+        out[name]["n_validation"] = int(len(Y_v))
+    return out
+
+
+def silverbox_extrapolation():
+    """The default search on Silverbox's training record; its arrow error near and away from the
+    outputs beyond the training range. None when the data are absent."""
+    from benchmarks.bench_real import DATA, SETS, _free_run, _load
+    from hwpts.identification import PWARX, PWARXSearch
+
+    cfg = SETS["silverbox"]
+    if not (DATA / cfg["train"][0]).exists():
+        return None
+    u, y = _load(cfg["train"], cfg["u"], cfg["y"])
+    tu, ty = _load(cfg["tests"]["arrow"], cfg["u"], cfg["y"])
+    t0 = time.perf_counter()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        search = PWARXSearch(PWARX(random_state=0), orders="auto").fit(u, y)
+    elapsed = time.perf_counter() - t0
+    out, n0 = _free_run(search.best_estimator_, tu, ty, cfg["n_init"])
+    err = (out - ty)[n0:] * cfg["scale"]
+    yt = ty[n0:]
+    beyond = (yt < y.min()) | (yt > y.max())
+    near = np.convolve(beyond.astype(float), np.ones(2 * NEAR + 1), mode="same") > 0
+    rms = lambda e: float(np.sqrt(np.mean(e ** 2))) if e.size else float("nan")  # noqa: E731
+    tenths = [rms(part) for part in np.array_split(err, 10)]
+    return {"train_range": (float(y.min()), float(y.max())), "arrow_range": (float(ty.min()), float(ty.max())),
+            "beyond_share": float(beyond.mean()), "near_share": float(near.mean()), "rmse": rms(err),
+            "rmse_near": rms(err[near]), "rmse_away": rms(err[~near]), "tenths": tenths,
+            "params": search.best_params_, "time": elapsed}
+
+
+def main(argv=None) -> int:
+    from benchmarks.bench_zoo import load_zoo
+
+    argv = list(argv or [])
+    seeds = DEFAULT_SEEDS
+    systems = None
+    for a in argv:
+        if a.startswith("--seeds="):
+            seeds = int(a.split("=", 1)[1])
+        elif a.startswith("--systems="):
+            systems = a.split("=", 1)[1].split(",")
+    zoo = load_zoo()
+    if zoo is None:
+        print("limits: the zoo (../shared/benchmarks/pwarx_zoo.py) was not found; boundary part skipped")
+    else:
+        names = systems or [n for n, (gen, meta) in zoo.SYSTEMS.items()
+                            if gen(rng=0, **({"n": 200} if n == "pwarx_random" else {})).theta is not None]
+        unknown = [n for n in names if n not in zoo.SYSTEMS]
+        if unknown:
+            print(f"limits: unknown system(s) {unknown}; available: {sorted(zoo.SYSTEMS)}", file=sys.stderr)
+            return 2
+        t0 = time.perf_counter()
+        res = boundary_limits(zoo, names, range(seeds))
+        print(f"1. true modes and parameters given, partition learned from the {seeds} training sets' true modes;")
+        print("   median one-step fit % on noise-free validation data [region accuracy %, misclassified samples]")
+        print(f"{'system':15s} {'n val':>6s} {'oracle':>7s} {'logistic (hwpts)':>24s} {'pairwise SVM':>24s} "
+              f"{'nearest sample':>24s}")
+        for name, r in res.items():
+            cells = [f"{r[k]['fit']:6.1f} [{r[k]['acc']:6.2f}, {r[k]['wrong']:4.0f}]" for k in ("logistic", "svm", "nearest")]
+            print(f"{name:15s} {r['n_validation']:6d} {r['oracle']['fit']:7.1f} " + " ".join(f"{c:>24s}" for c in cells))
+        print(f"   ({time.perf_counter() - t0:.1f} s)")
+    if "--no-silverbox" in argv:
+        return 0
+    sb = silverbox_extrapolation()
+    if sb is None:
+        print("2. Silverbox skipped: ../shared/data/silverbox not found (set HWPTS_DATA_DIR)")
+        return 0
+    p = sb["params"]
+    print(f"2. Silverbox, the default search's model (na {p.get('output_order')}, nb {p.get('input_order')}, "
+          f"{p.get('segmentation')}, {p.get('n_regions')} regions{', polished' if p.get('polish') else ''}; "
+          f"search {sb['time']:.1f} s)")
+    print(f"   training outputs span [{sb['train_range'][0]:.3f}, {sb['train_range'][1]:.3f}] V, the arrow's "
+          f"[{sb['arrow_range'][0]:.3f}, {sb['arrow_range'][1]:.3f}] V ({100 * sb['beyond_share']:.2f} % of its "
+          f"samples beyond the training range)")
+    print(f"   arrow free-run RMSE {sb['rmse']:.2f} mV: {sb['rmse_near']:.2f} mV over the {100 * sb['near_share']:.1f} % "
+          f"of samples within {NEAR} samples of an output beyond the training range, {sb['rmse_away']:.2f} mV "
+          f"over the rest")
+    print("   RMSE per tenth of the record [mV]: " + ", ".join(f"{t:.2f}" for t in sb["tenths"]))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
