@@ -230,7 +230,7 @@ def test_threshold_block_costs_are_the_least_squares_residuals(n):
     Phi = np.column_stack([X, np.ones(n)])
     y = np.where(X[:, 0] > 0.3, X @ [1.0, 2.0], X @ [-1.0, 0.5]) + 0.1 * rng.standard_normal(n)
     th._COST_CACHE.clear()
-    xs, nodes, cost, whole = th._split_costs(X[:, 0], Phi, y, 20, 50)
+    xs, nodes, cost, whole, *_ = th._split_costs(X[:, 0], Phi, y, 20, 50)
     order = np.argsort(X[:, 0], kind="stable")
     for i, j in [(0, 1), (0, nodes.size - 1), (nodes.size // 3, 2 * nodes.size // 3)]:
         rows = order[nodes[i]:nodes[j]]
@@ -240,3 +240,51 @@ def test_threshold_block_costs_are_the_least_squares_residuals(n):
         residual = y[rows] - Phi[rows] @ np.linalg.lstsq(Phi[rows], y[rows], rcond=None)[0]
         assert cost[i, j] == pytest.approx(residual @ residual, rel=1e-5)  # (a 1e-10 ridge)
     assert whole == pytest.approx(cost[0, nodes.size - 1], rel=1e-12)
+
+
+def test_a_grid_of_cuts_is_refined_to_the_exact_thresholds():
+    """With more distinct values than ``n_grid`` the dynamic programme runs on a grid of cuts; each
+    cut is then moved to its exact least-squares position between the grid nodes around it (on
+    3,000 rows of this map the grid alone put the cuts at -1.006, -0.004, 0.993: a validation fit
+    of 91.75 % instead of 99.94 %)."""
+    from hwpts.identification.segmentation.threshold import optimal_split
+
+    rng = np.random.default_rng(3)
+    x = rng.uniform(-2, 2, 3000)
+    Phi = np.column_stack([x, np.ones_like(x)])
+    pieces = np.select([x <= -1, x <= 0, x <= 1], [2 * x + 1, -x + 0.5, 3 * x - 1], -x + 4)
+    y = pieces + 0.02 * rng.standard_normal(x.size)
+    sse, thresholds = optimal_split(x, Phi, y, 4, min_rows=10, n_grid=200)
+    assert np.allclose(thresholds, [-1, 0, 1], atol=0.004)
+    truth = sum(float(np.sum((y[m] - Phi[m] @ np.linalg.lstsq(Phi[m], y[m], rcond=None)[0]) ** 2))
+                for m in (x <= -1, (x > -1) & (x <= 0), (x > 0) & (x <= 1), x > 1))
+    assert sse <= truth * (1 + 1e-4)  # (the costs carry a 1e-10 relative ridge)
+    # the exhaustive search over every distinct value (n_grid above their number) agrees
+    exact_sse, exact_thresholds = optimal_split(x, Phi, y, 4, min_rows=10, n_grid=5000)
+    assert sse == pytest.approx(exact_sse, rel=1e-6)
+    assert np.allclose(thresholds, exact_thresholds)
+
+
+def test_threshold_keeps_to_the_partition_columns():
+    """``partition_columns`` limits the threshold variable too (the columns the user allows the
+    boundaries to use); an explicit threshold column outside them is refused."""
+    u, y = setar(1500, 1)
+    free = PWARX(output_order=1, input_order=1, segmentation="threshold", n_regions=2).fit(u, y)
+    kept = PWARX(output_order=1, input_order=1, segmentation="threshold", n_regions=2,
+                 partition_columns=["u1(k-1)"]).fit(u, y)
+    assert free.segmentation_info_["column"] == "y(k-1)"
+    assert kept.segmentation_info_["column"] == "u1(k-1)"
+    with pytest.raises(ParameterError, match="not among the partition columns"):
+        PWARX(output_order=1, input_order=1, segmentation="threshold", n_regions=2,
+              segmentation_params={"column": "y(k-1)"}, partition_columns=["u1(k-1)"]).fit(u, y)
+
+
+def test_the_cost_cache_is_bounded_by_bytes_too():
+    from hwpts.identification.segmentation.base import BoundedCache
+
+    cache = BoundedCache(100, maxbytes=3 * 800)
+    for k in range(5):
+        cache.get_or_compute(k, lambda: (np.zeros(100), 1.0))  # 800 bytes each
+    assert list(cache) == [2, 3, 4] and cache._bytes == 2400
+    cache.clear()
+    assert cache._bytes == 0 and not cache

@@ -287,7 +287,8 @@ class PWARX(BaseEstimator):
         if segmenter.learns_partition and limit is not None and X_reg.shape[0] > limit:
             rows = np.sort(rng.choice(X_reg.shape[0], int(limit), replace=False))
             X_seg, y_seg = X_reg[rows], target[rows]
-        seg = segmenter.segment(X_seg, y_seg, n_regions, structure, rng)
+        seg = (segmenter.segment(X_seg, y_seg, n_regions, structure, rng, columns=pcols)
+               if segmenter.restricts_columns else segmenter.segment(X_seg, y_seg, n_regions, structure, rng))
         s = seg.n_regions
         kinds = self._kinds(s)
         sparse_columns = None

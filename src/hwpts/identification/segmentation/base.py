@@ -50,6 +50,9 @@ class Segmenter(BaseEstimator):
     uses_n_regions = True
     #: whether the estimator learns the partition from the labels (then it may segment a subsample)
     learns_partition = False
+    #: whether the method draws its own fixed partition on regressor columns, so that
+    #: ``segment`` takes ``columns=`` (the indices a PWARX's ``partition_columns`` allows)
+    restricts_columns = False
 
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:  # pragma: no cover
         """Assign the regressor rows ``X`` with targets ``y`` to ``n_regions`` regions; returns a :class:`SegmentationResult` (labels, and a partition when the method defines one)."""
@@ -81,24 +84,40 @@ def fingerprint(*arrays) -> bytes:
     return h.digest()
 
 
+def _nbytes(value) -> int:
+    """Bytes held by the arrays of a cached value (an array or a tuple of arrays and scalars)."""
+    items = value if isinstance(value, tuple) else (value,)
+    return int(sum(getattr(v, "nbytes", 0) for v in items))
+
+
 class BoundedCache(dict):
     """A small first-in-first-out cache (the segmenters' costs that do not depend on the number of
-    regions, keyed by :func:`fingerprint` of their rows): at most ``maxsize`` entries."""
+    regions, keyed by :func:`fingerprint` of their rows): at most ``maxsize`` entries and, if
+    ``maxbytes`` is given, at most that many bytes of arrays."""
 
-    def __init__(self, maxsize: int):
+    def __init__(self, maxsize: int, maxbytes: int | None = None):
         super().__init__()
         self.maxsize = int(maxsize)
+        self.maxbytes = maxbytes
+        self._bytes = 0
 
     def get_or_compute(self, key, compute):
-        """The value stored under ``key``, or ``compute()`` stored there (the oldest entry dropped
+        """The value stored under ``key``, or ``compute()`` stored there (the oldest entries dropped
         when full)."""
         hit = self.get(key)
         if hit is None:
             hit = compute()
-            if len(self) >= self.maxsize:
-                self.pop(next(iter(self)))
+            size = _nbytes(hit)
+            while self and (len(self) >= self.maxsize
+                            or (self.maxbytes is not None and self._bytes + size > self.maxbytes)):
+                self._bytes -= _nbytes(self.pop(next(iter(self))))
             self[key] = hit
+            self._bytes += size
         return hit
+
+    def clear(self) -> None:
+        super().clear()
+        self._bytes = 0
 
 
 def kmeans_labels(F: np.ndarray, n_clusters: int, rng, n_init: int = 10, sample_weight=None,

@@ -12,8 +12,12 @@ gives the residual sum of squares of any block from one small solve. The best ``
 (each block holding at least ``min_share`` of the rows and more rows than parameters) is then the
 optimal segmentation of a sequence, found by dynamic programming (Bellman 1961; Bai & Perron 1998
 for multiple structural breaks) in ``O(s G^2)`` for ``G`` candidate cuts: every position where
-``x_c`` changes on small data (so the split is the global least-squares optimum), ``n_grid``
-quantiles on large data. With ``column=None`` every regressor column is tried and the one with the
+``x_c`` changes on small data (at most 400 rows) or when there are at most ``n_grid`` of them
+(the split is then the global least-squares optimum); otherwise ``n_grid`` quantiles, and each cut of the grid's optimum is then
+moved to the exact least-squares position between the grid nodes around it (coordinate descent,
+one cut at a time: on 3,000 rows of a 4-piece static map with jumps at -1, 0, 1 the grid alone
+put the cuts at -1.006, -0.004, 0.993, a noise-free validation fit of 91.75 % instead of 99.94 %).
+With ``column=None`` every regressor column is tried and the one with the
 smallest residual sum of squares wins. The result is deterministic (no random restarts) and the
 partition is fixed (no boundary refinement): few boundary parameters, low variance, which suits
 free-run simulation; on one-dimensional switching (a static map, or a system switching on one
@@ -60,6 +64,8 @@ def _sse(G, b, yy, ridge):
     return float(yy - b @ theta)
 
 
+
+
 EXACT_ROWS = 400  # up to this many rows, every change of the threshold variable is a candidate cut
 
 
@@ -77,12 +83,16 @@ def _block_sse(CG, Cb, Cy, a, b, ridge):
     return np.maximum(yy - np.einsum("ni,ni->n", r, theta), 0.0)
 
 
-_COST_CACHE = BoundedCache(48)  # fingerprint of (x, Phi, y), min_rows, n_grid -> block costs (see _split_costs)
+# fingerprint of (x, Phi, y), min_rows, n_grid -> block costs (see _split_costs): one entry per
+# column and fold, kept while a search grows the regions (16 columns x 5 folds thrashed 48 entries:
+# every region count recomputed every table); a table of 200 cuts holds 0.3 MB
+_COST_CACHE = BoundedCache(1024, maxbytes=128 * 2**20)
 
 
 def _split_costs(x, Phi, y, min_rows, n_grid, data_key=None):
-    """Sorted ``x``, the candidate block boundaries and the least-squares cost of every admissible
-    block between two of them. They do not depend on the number of regions: a model search that
+    """Sorted ``x``, the candidate block boundaries, the least-squares cost of every admissible
+    block between two of them, the cost of all rows in one block and whether the boundaries are a
+    grid (fewer than the positions where ``x`` changes). They do not depend on the number of regions: a model search that
     grows the regions on the same rows reuses them (a small cache keyed by the data's hash;
     ``data_key``: a fingerprint of ``(Phi, y)`` already computed, with ``x`` a column of ``Phi``
     named in it, which spares hashing the rows again for every column)."""
@@ -97,7 +107,8 @@ def _block_costs(x, Phi, y, min_rows, n_grid):
     xs = x[order]
     changes = np.flatnonzero(xs[1:] > xs[:-1]) + 1  # a cut at k splits rows [0, k) | [k, n)
     changes = changes[(changes >= min_rows) & (changes <= n - min_rows)]
-    if n > EXACT_ROWS and changes.size > n_grid:
+    gridded = n > EXACT_ROWS and changes.size > n_grid
+    if gridded:
         pick = np.unique(np.searchsorted(changes, np.quantile(changes, np.linspace(0, 1, n_grid))))
         changes = changes[np.clip(pick, 0, changes.size - 1)]
         changes = np.unique(changes)
@@ -122,16 +133,17 @@ def _block_costs(x, Phi, y, min_rows, n_grid):
     ok = (nodes[ib] - nodes[ia]) >= min_rows
     cost = np.full((m, m), np.inf)
     cost[ia[ok], ib[ok]] = _block_sse(CG, Cb, Cy, ia[ok], ib[ok], ridge)
-    return xs, nodes, cost, whole
+    return xs, nodes, cost, whole, gridded, order, ridge
 
 
-def optimal_split(x, Phi, y, n_regions, min_rows, n_grid=200, data_key=None):
+def optimal_split(x, Phi, y, n_regions, min_rows, n_grid=200, data_key=None, refine=True):
     """Exact least-squares split of the rows into ``n_regions`` intervals of ``x`` (module doc).
 
     Returns ``(sse, thresholds)``; ``sse`` is ``inf`` when no admissible split exists.
-    ``data_key``: see :func:`_split_costs`.
+    ``data_key``: see :func:`_split_costs`. ``refine=False`` returns the grid's optimum as it is
+    (on large data; the segmenter compares the columns by it and refines the winner's cuts).
     """
-    xs, nodes, cost, whole = _split_costs(np.asarray(x, dtype=float), np.asarray(Phi, dtype=float),
+    xs, nodes, cost, whole, gridded, order, ridge = _split_costs(np.asarray(x, dtype=float), np.asarray(Phi, dtype=float),
                                           np.asarray(y, dtype=float), min_rows, n_grid, data_key)
     if n_regions == 1:
         return whole, []
@@ -152,7 +164,72 @@ def optimal_split(x, Phi, y, n_regions, min_rows, n_grid=200, data_key=None):
         j = int(arg[j])
         cuts.append(int(nodes[j]))
     cuts = cuts[::-1]
-    return float(D[-1]), [0.5 * (xs[k - 1] + xs[k]) for k in cuts]
+    sse = float(D[-1])
+    if gridded and refine:  # the DP saw a grid of cuts: each cut moves to its exact best between the nodes around it
+        sse, cuts = _refine_cuts(xs, order, np.asarray(Phi, dtype=float), np.asarray(y, dtype=float), nodes, cuts,
+                                 min_rows, sse, ridge)
+    return sse, [0.5 * (xs[k - 1] + xs[k]) for k in cuts]
+
+
+def _refine_cuts(xs, order, Phi, y, nodes, cuts, min_rows, sse, ridge, rounds=3):
+    """``(sse, cuts)`` of a grid solution with each cut moved to the best exact position between
+    the grid nodes around it, one cut at a time with its neighbours held (coordinate descent on
+    the exact residual sum of squares, a few rounds). The exact cost of every position between two
+    nodes is one running sum of the rows there; the result is never worse than the grid's."""
+    n = xs.size
+    p = Phi.shape[1]
+
+    def gram(a, b):  # [Phi y]' [Phi y] over the sorted rows [a, b)
+        rows = order[a:b]
+        block = np.column_stack([Phi[rows], y[rows]])
+        return block.T @ block, block
+
+    cuts = [int(k) for k in cuts]
+    pos = [int(np.searchsorted(nodes, k)) for k in cuts]  # each cut's grid node
+    for _ in range(rounds):
+        moved = False
+        for j, k in enumerate(cuts):
+            a = cuts[j - 1] if j > 0 else 0
+            b = cuts[j + 1] if j + 1 < len(cuts) else n
+            lo = max(int(nodes[max(pos[j] - 1, 0)]), a + min_rows)
+            hi = min(int(nodes[min(pos[j] + 1, nodes.size - 1)]), b - min_rows)
+            if hi <= lo:
+                continue
+            base, _ = gram(a, lo)
+            inner, window = gram(lo, hi)
+            total = base + inner + gram(hi, b)[0]
+            # the left block [a, c) for c = lo .. hi: base plus the window's rows before c
+            left = np.concatenate([base[None], base + np.cumsum(window[:, :, None] * window[:, None, :], axis=0)])
+            cand = np.arange(lo, hi + 1)
+            ok = xs[cand - 1] < xs[np.minimum(cand, n - 1)]  # a cut between two distinct values
+            if not np.any(ok):
+                continue
+            costs = np.full(cand.size, np.inf)
+            costs[ok] = _sse_many(left[ok], p, ridge) + _sse_many(total - left[ok], p, ridge)
+            best = int(np.argmin(costs))
+            here = np.flatnonzero(cand == k)
+            if cand[best] != k and (here.size == 0 or costs[best] < costs[here[0]]):
+                cuts[j] = int(cand[best])
+                moved = True
+        if not moved:
+            break
+    edges = [0] + cuts + [n]
+    refined = float(sum(_sse_many(gram(a, b)[0][None], p, ridge)[0] for a, b in zip(edges[:-1], edges[1:])))
+    return refined, cuts  # each move lowered the cost of its two blocks: refined <= the grid's sse
+
+
+def _sse_many(S, p, ridge):
+    """Residual sums of squares of least squares from stacked augmented Gram matrices
+    ``S = [Phi y]' [Phi y]`` (k, p + 1, p + 1)."""
+    if S.shape[0] == 0:
+        return np.zeros(0)
+    G = S[:, :p, :p] + ridge * np.eye(p)
+    r = S[:, :p, p]
+    try:
+        theta = np.linalg.solve(G, r[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        theta = np.einsum("nij,nj->ni", np.linalg.pinv(G), r)
+    return np.maximum(S[:, p, p] - np.einsum("ni,ni->n", r, theta), 0.0)
 
 
 class ThresholdSegmenter(Segmenter):
@@ -165,30 +242,40 @@ class ThresholdSegmenter(Segmenter):
         (the output's name means its first lag); ``None`` (default) tries every regressor column
         and keeps the best.
     n_grid : int
-        Candidate cuts on large data (more than 400 rows): this many quantiles of the column.
+        Candidate cuts on large data (more than 400 rows) when the column takes more values: this
+        many quantiles (each cut then refined to its exact best position between the quantiles
+        around it).
     min_share : float
         Smallest share of the training rows in each region (and always more rows than parameters).
     """
 
     name = "threshold"
     uses_n_regions = True
+    restricts_columns = True
 
     def __init__(self, *, column: str | None = None, n_grid: int = 200, min_share: float = 0.03):
         self.column = column
         self.n_grid = n_grid
         self.min_share = min_share
 
-    def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
-        """The exact least-squares thresholds on the chosen column (or the best column), as a fixed partition."""
+    def segment(self, X, y, n_regions, structure, rng, columns=None) -> SegmentationResult:
+        """The exact least-squares thresholds on the chosen column (or the best column), as a fixed
+        partition. ``columns``: the regressor columns a threshold may use (a PWARX's
+        ``partition_columns``); default all."""
         self._check_regions(n_regions, X.shape[0])
         if not 0 < self.min_share < 1 / max(n_regions, 2) or int(self.n_grid) < 2:
             raise ParameterError(f"threshold: min_share must be in (0, 1/n_regions) and n_grid >= 2; "
                                  f"got {self.min_share}, {self.n_grid}")
         n, nf = X.shape
+        allowed = range(nf) if columns is None else sorted({int(c) for c in columns})
         if self.column is None:
-            columns = [c for c in range(nf) if np.ptp(X[:, c]) > 0]
+            columns = [c for c in allowed if np.ptp(X[:, c]) > 0]
         else:
             columns = [structure.column_index(self.column)]
+            if columns[0] not in allowed:
+                raise ParameterError(
+                    f"threshold: column {self.column!r} is not among the partition columns "
+                    f"{[structure.feature_names[c] for c in allowed]}")
         if n_regions == 1 or not columns:
             name = self.column if self.column is not None else None
             return SegmentationResult(np.zeros(n, dtype=np.int64), 1, RegionPartition.single(nf),
@@ -198,12 +285,15 @@ class ThresholdSegmenter(Segmenter):
         min_rows = max(int(np.ceil(self.min_share * n)), p + 1)
         best = (np.inf, None, None)
         rows = fingerprint(Phi, y)  # once for every column (hashing the rows costs as much as a split)
-        for c in columns:
+        for c in columns:  # the columns compared by their grid optimum; the winner's cuts refined
             sse, thresholds = optimal_split(X[:, c], Phi, y, n_regions, min_rows, int(self.n_grid),
-                                            data_key=(rows, c))
+                                            data_key=(rows, c), refine=len(columns) == 1)
             if sse < best[0]:
                 best = (sse, c, thresholds)
         sse, c, thresholds = best
+        if c is not None and len(columns) > 1:
+            sse, thresholds = optimal_split(X[:, c], Phi, y, n_regions, min_rows, int(self.n_grid),
+                                            data_key=(rows, c))
         if c is None:
             raise IdentificationError(
                 f"threshold: no split of {n} rows into {n_regions} regions of >= {min_rows} rows each "
