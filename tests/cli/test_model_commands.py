@@ -95,6 +95,18 @@ def test_unknown_column(tmp_path, data_csv, capsys):
                            "--out", str(out)], "no column(s) ['nope']; available columns are", out)
 
 
+def test_an_unknown_column_lists_the_files_columns(tmp_path, capsys):
+    # the message listed only the requested columns it had found (u missing from the list below)
+    path = tmp_path / "d.csv"
+    path.write_text("t,u,y\n" + "".join(f"{k},{k % 3},{k % 5}\n" for k in range(50)))
+    _expect_error(capsys, ["identify", str(path), "--input", "x", "--output", "y", "--out", str(tmp_path / "m.json")],
+                  "no column(s) ['x']; available columns are ['t', 'u', 'y']")
+    headless = tmp_path / "h.csv"
+    headless.write_text("".join(f"{k},{k + 0.5}\n" for k in range(50)))
+    _expect_error(capsys, ["identify", str(headless), "--input", "u", "--output", "y", "--out", str(tmp_path / "m.json")],
+                  "a header row such as u,y")
+
+
 def test_too_few_samples(tmp_path, capsys):
     path = tmp_path / "short.csv"
     rng = np.random.default_rng(0)

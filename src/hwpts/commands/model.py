@@ -39,6 +39,29 @@ TIME_COLUMNS = ("time_s", "t_s", "time", "t")
 NO_TIME = "none"  # --time none: no time column, the sample index is the time axis
 
 
+def _available(path, found) -> str:
+    """The file's columns for an error message (those read so far if the whole file cannot be read),
+    with a hint when its first row holds numbers (no header row)."""
+    from hwpts.io.datasets import read_table
+
+    try:
+        names = sorted(read_table(path))
+    except (DataError, OSError, ValueError):
+        names = sorted(found)
+    text = f"available columns are {names}"
+
+    def number(name):
+        try:
+            float(name)
+        except ValueError:
+            return False
+        return True
+
+    if names and all(number(n) for n in names) or not names:
+        text += " (the first row must name the columns: a header row such as u,y)"
+    return text
+
+
 def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
     """The named columns of a data file as an :class:`IODataset`; its ``sample_time_s`` attribute
     is the sample period from the time column, or None when the file has none (time = row index).
@@ -67,7 +90,7 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
         raise DataError(f"{str(path)!r}: no time column {time_name!r}; available columns are {sorted(columns)}")
     missing = [c for c in signals if c not in columns]
     if missing:
-        raise DataError(f"{str(path)!r}: no column(s) {missing}; available columns are {sorted(columns)}")
+        raise DataError(f"{str(path)!r}: no column(s) {missing}; {_available(path, columns)}")
     sl = _rows(rows)
     cols = {k: np.asarray(v)[sl] for k, v in columns.items()}
     n = len(cols[output_name])
