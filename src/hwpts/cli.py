@@ -22,6 +22,7 @@ from hwpts.io.atomic import INTERRUPTED as _INTERRUPTED  # set by SIGINT/SIGTERM
 
 EXIT_OK = 0
 EXIT_USAGE = 2
+_INTERRUPTED_FRAMES: list = []  # see _run: interrupted runs' exceptions, kept until the process ends
 
 
 class ArgumentParser(argparse.ArgumentParser):
@@ -125,6 +126,10 @@ def _run(argv: Sequence[str] | None) -> int:
         status = int(args.handler(args) or EXIT_OK)
     except BaseException as error:
         if isinstance(error, KeyboardInterrupt) or (_INTERRUPTED.is_set() and isinstance(error, Exception)):
+            # the interrupted frames stay referenced until the process ends: freeing them runs the
+            # destructors of whatever they held, and a compiler (LLVM under numba) stopped mid-way
+            # can crash there (exit -11 right after this line, seen once under SIGTERM)
+            _INTERRUPTED_FRAMES.append(error)
             print("hwpts: interrupted", file=sys.stderr)
             return 130
         return _report(error)

@@ -116,6 +116,7 @@ class BoundedCache(dict):
         return hit
 
     def clear(self) -> None:
+        """Drop every entry."""
         super().clear()
         self._bytes = 0
 

@@ -216,7 +216,7 @@ class PWARXSearch(BaseEstimator):
     >>> search.best_estimator_.n_regions_
     2
     >>> search.best_params_["n_regions"], round(search.best_score_)  # held-out fit %
-    (2, 95)
+    (2, 96)
     """
 
     def __init__(self, estimator=None, param_grid=None, *, cv=None, methods=DEFAULT_METHODS, orders=None,
