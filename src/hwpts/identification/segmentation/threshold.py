@@ -54,33 +54,7 @@ def threshold_partition(column: int, thresholds, n_features: int) -> RegionParti
     return RegionPartition(H, g, kind="thresholds")
 
 
-def _sse(G, b, yy, ridge):
-    """Residual sum of squares of least squares from the normal equations (G, b, y'y)."""
-    p = G.shape[0]
-    try:
-        theta = np.linalg.solve(G + ridge * np.eye(p), b)
-    except np.linalg.LinAlgError:
-        return np.inf
-    return float(yy - b @ theta)
-
-
-
-
 EXACT_ROWS = 400  # up to this many rows, every change of the threshold variable is a candidate cut
-
-
-def _block_sse(CG, Cb, Cy, a, b, ridge):
-    """Residual sums of squares of least squares on sorted-row blocks ``[a_j, b_j)`` (vectorised)."""
-    G = CG[b] - CG[a]
-    r = Cb[b] - Cb[a]
-    yy = Cy[b] - Cy[a]
-    p = G.shape[-1]
-    G = G + ridge * np.eye(p)
-    try:
-        theta = np.linalg.solve(G, r[..., None])[..., 0]
-    except np.linalg.LinAlgError:
-        theta = np.einsum("nij,nj->ni", np.linalg.pinv(G), r)
-    return np.maximum(yy - np.einsum("ni,ni->n", r, theta), 0.0)
 
 
 # fingerprint of (x, Phi, y), min_rows, n_grid -> block costs (see _split_costs): one entry per
@@ -125,14 +99,12 @@ def _block_costs(x, Phi, y, min_rows, n_grid):
         C = np.cumsum(steps, axis=0)
     else:  # few rows between boundaries (small data): running sums over the rows
         C = np.concatenate([np.zeros((1, p + 1, p + 1)), np.cumsum(Pw[:, :, None] * Pw[:, None, :], axis=0)])[nodes]
-    CG, Cb, Cy = C[:, :p, :p], C[:, :p, p], C[:, p, p]
-    ridge = 1e-10 * float(np.trace(CG[-1])) / p
-    idx = np.arange(m)
-    whole = float(_block_sse(CG, Cb, Cy, idx[:1], idx[-1:], ridge)[0])
+    ridge = 1e-10 * float(np.trace(C[-1, :p, :p])) / p
+    whole = float(_sse_many(C[-1:] - C[:1], p, ridge)[0])
     ia, ib = np.triu_indices(m, k=1)
     ok = (nodes[ib] - nodes[ia]) >= min_rows
     cost = np.full((m, m), np.inf)
-    cost[ia[ok], ib[ok]] = _block_sse(CG, Cb, Cy, ia[ok], ib[ok], ridge)
+    cost[ia[ok], ib[ok]] = _sse_many(C[ib[ok]] - C[ia[ok]], p, ridge)
     return xs, nodes, cost, whole, gridded, order, ridge
 
 
@@ -220,7 +192,7 @@ def _refine_cuts(xs, order, Phi, y, nodes, cuts, min_rows, sse, ridge, rounds=3)
 
 def _sse_many(S, p, ridge):
     """Residual sums of squares of least squares from stacked augmented Gram matrices
-    ``S = [Phi y]' [Phi y]`` (k, p + 1, p + 1)."""
+    ``S = [Phi y]' [Phi y]`` (k, p + 1, p + 1) of blocks of rows (a ``ridge`` on the diagonal)."""
     if S.shape[0] == 0:
         return np.zeros(0)
     G = S[:, :p, :p] + ridge * np.eye(p)
