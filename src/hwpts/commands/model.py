@@ -49,17 +49,17 @@ def _available(path, found) -> str:
     except (DataError, OSError, ValueError):
         names = sorted(found)
     text = f"available columns are {names}"
-
-    def number(name):
-        try:
-            float(name)
-        except ValueError:
-            return False
-        return True
-
-    if names and all(number(n) for n in names) or not names:
+    if not names or all(_is_number(n) for n in names):
         text += " (the first row must name the columns: a header row such as u,y)"
     return text
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
@@ -87,7 +87,7 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
             raise
         columns = read_table(path, signals)  # a conventionally named column that holds text is no time axis
     if time_name not in (None, NO_TIME) and time_name not in columns:
-        raise DataError(f"{str(path)!r}: no time column {time_name!r}; available columns are {sorted(columns)}")
+        raise DataError(f"{str(path)!r}: no time column {time_name!r}; {_available(path, columns)}")
     missing = [c for c in signals if c not in columns]
     if missing:
         raise DataError(f"{str(path)!r}: no column(s) {missing}; {_available(path, columns)}")

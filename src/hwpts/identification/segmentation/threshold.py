@@ -13,12 +13,12 @@ gives the residual sum of squares of any block from one small solve. The best ``
 optimal segmentation of a sequence, found by dynamic programming (Bellman 1961; Bai & Perron 1998
 for multiple structural breaks) in ``O(s G^2)`` for ``G`` candidate cuts: every position where
 ``x_c`` changes on small data (at most 400 rows) or when there are at most ``n_grid`` of them
-(the split is then the global least-squares optimum); otherwise ``n_grid`` quantiles, and each cut of the grid's optimum is then
-moved to the exact least-squares position between the grid nodes around it (coordinate descent,
-one cut at a time: on 3,000 rows of a 4-piece static map with jumps at -1, 0, 1 the grid alone
-put the cuts at -1.006, -0.004, 0.993, a noise-free validation fit of 91.75 % instead of 99.94 %).
-With ``column=None`` every regressor column is tried and the one with the
-smallest residual sum of squares wins. The result is deterministic (no random restarts) and the
+(the split is then the global least-squares optimum); otherwise ``n_grid`` quantiles, and each
+cut of the grid's optimum is then moved to the exact least-squares position between the grid
+nodes around it (coordinate descent, one cut at a time: on 3,000 rows of a 4-piece static map
+with jumps at -1, 0, 1 the grid alone put the cuts at -1.006, -0.004, 0.993, a noise-free
+validation fit of 91.75 % instead of 99.94 %). With ``column=None`` every regressor column is
+tried and the one with the smallest residual sum of squares (on the grid) wins. The result is deterministic (no random restarts) and the
 partition is fixed (no boundary refinement): few boundary parameters, low variance, which suits
 free-run simulation; on one-dimensional switching (a static map, or a system switching on one
 signal) it is the least-squares estimate of the switching points, which no clustering method is.
@@ -65,9 +65,10 @@ _COST_CACHE = BoundedCache(1024, maxbytes=128 * 2**20)
 
 def _split_costs(x, Phi, y, min_rows, n_grid, data_key=None):
     """Sorted ``x``, the candidate block boundaries, the least-squares cost of every admissible
-    block between two of them, the cost of all rows in one block and whether the boundaries are a
-    grid (fewer than the positions where ``x`` changes). They do not depend on the number of regions: a model search that
-    grows the regions on the same rows reuses them (a small cache keyed by the data's hash;
+    block between two of them, the cost of all rows in one block, whether the boundaries are a
+    grid (fewer than the positions where ``x`` changes), the sorting order and the ridge. They do
+    not depend on the number of regions: a model search that grows the regions on the same rows
+    reuses them (a small cache keyed by the data's hash;
     ``data_key``: a fingerprint of ``(Phi, y)`` already computed, with ``x`` a column of ``Phi``
     named in it, which spares hashing the rows again for every column)."""
     key = (data_key if data_key is not None else fingerprint(x, Phi, y), int(min_rows), int(n_grid))
@@ -115,8 +116,9 @@ def optimal_split(x, Phi, y, n_regions, min_rows, n_grid=200, data_key=None, ref
     ``data_key``: see :func:`_split_costs`. ``refine=False`` returns the grid's optimum as it is
     (on large data; the segmenter compares the columns by it and refines the winner's cuts).
     """
-    xs, nodes, cost, whole, gridded, order, ridge = _split_costs(np.asarray(x, dtype=float), np.asarray(Phi, dtype=float),
-                                          np.asarray(y, dtype=float), min_rows, n_grid, data_key)
+    Phi, y = np.asarray(Phi, dtype=float), np.asarray(y, dtype=float)
+    xs, nodes, cost, whole, gridded, order, ridge = _split_costs(np.asarray(x, dtype=float), Phi, y, min_rows,
+                                                                 n_grid, data_key)
     if n_regions == 1:
         return whole, []
     m = nodes.size
@@ -137,13 +139,12 @@ def optimal_split(x, Phi, y, n_regions, min_rows, n_grid=200, data_key=None, ref
         cuts.append(int(nodes[j]))
     cuts = cuts[::-1]
     sse = float(D[-1])
-    if gridded and refine:  # the DP saw a grid of cuts: each cut moves to its exact best between the nodes around it
-        sse, cuts = _refine_cuts(xs, order, np.asarray(Phi, dtype=float), np.asarray(y, dtype=float), nodes, cuts,
-                                 min_rows, sse, ridge)
+    if gridded and refine:  # the DP saw a grid: each cut moves to its exact best between the nodes around it
+        sse, cuts = _refine_cuts(xs, order, Phi, y, nodes, cuts, min_rows, ridge)
     return sse, [0.5 * (xs[k - 1] + xs[k]) for k in cuts]
 
 
-def _refine_cuts(xs, order, Phi, y, nodes, cuts, min_rows, sse, ridge, rounds=3):
+def _refine_cuts(xs, order, Phi, y, nodes, cuts, min_rows, ridge, rounds=3):
     """``(sse, cuts)`` of a grid solution with each cut moved to the best exact position between
     the grid nodes around it, one cut at a time with its neighbours held (coordinate descent on
     the exact residual sum of squares, a few rounds). The exact cost of every position between two
