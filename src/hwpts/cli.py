@@ -115,12 +115,36 @@ def main(argv: Sequence[str] | None = None) -> int:
         _INTERRUPTED.clear()
 
 
+# options whose value may start with a minus sign (a negative coefficient, a slice from the end):
+# argparse takes "--hyperplane -1,0,2.8" for two options; the value is attached as "--hyperplane=-1,0,2.8"
+NEGATIVE_VALUE_OPTIONS = ("--hyperplane", "--rows")
+
+
+def _attach_negative_values(argv: Sequence[str]) -> list[str]:
+    """``[..., "--hyperplane", "-1,0,2.8", ...]`` -> ``[..., "--hyperplane=-1,0,2.8", ...]`` (a value
+    that starts with a minus sign and a digit, or with ``-.`` or ``-:``); other tokens unchanged."""
+    out: list[str] = []
+    tokens = list(argv)
+    i = 0
+    while i < len(tokens):
+        token = tokens[i]
+        nxt = tokens[i + 1] if i + 1 < len(tokens) else None
+        if token in NEGATIVE_VALUE_OPTIONS and nxt is not None and len(nxt) > 1 and nxt[0] == "-" \
+                and (nxt[1].isdigit() or nxt[1] in ".:"):
+            out.append(f"{token}={nxt}")
+            i += 2
+            continue
+        out.append(token)
+        i += 1
+    return out
+
+
 def _run(argv: Sequence[str] | None) -> int:
     """Parse and dispatch; every failure becomes one line and an exit status. The parser is built
     here, after the signal handlers are in place: building it imports the command modules (numpy
     and more), and a Ctrl-C or SIGTERM in that time is an interrupt like any other."""
     try:
-        args = build_parser().parse_args(argv)
+        args = build_parser().parse_args(_attach_negative_values(sys.argv[1:] if argv is None else argv))
         args.command_line = shlex.join(["hwpts", *(sys.argv[1:] if argv is None else argv)])
         _check_outputs(args)
         status = int(args.handler(args) or EXIT_OK)

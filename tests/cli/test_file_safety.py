@@ -39,14 +39,17 @@ def _one_line_error(capsys, argv, match):
 
 def test_output_over_an_input_is_refused(tmp_path, data_csv, capsys):
     before = data_csv.read_bytes()
-    _one_line_error(capsys, ["identify", str(data_csv), *FIT, "--out", str(data_csv)], "would destroy the input")
+    # a model file is .json: the data file is refused before anything is read
+    _one_line_error(capsys, ["identify", str(data_csv), *FIT, "--out", str(data_csv)], "expected a .json file name")
     assert data_csv.read_bytes() == before
     model = tmp_path / "m.json"
     assert main(["identify", str(data_csv), *FIT, "--out", str(model)]) == 0
     capsys.readouterr()
     saved = model.read_bytes()
-    _one_line_error(capsys, ["predict", str(model), str(data_csv), "--out", str(model)], "is the model file")
+    _one_line_error(capsys, ["predict", str(model), str(data_csv), "--out", str(model)], "expected a .csv or .parquet")
     assert model.read_bytes() == saved
+    _one_line_error(capsys, ["predict", str(model), str(data_csv), "--out", str(data_csv)], "is the data file")
+    assert data_csv.read_bytes() == before
     inputs = tmp_path / "inp.csv"
     write_csv(inputs, {"time_s": np.arange(50) * 0.01, "valve_voltage_v": np.full(50, 2.0),
                        "pump_speed_rpm": np.full(50, 600.0)})

@@ -268,6 +268,18 @@ def test_hyperplane_with_a_negative_first_coefficient(tmp_path, data_csv, capsys
     assert summary["segmentation"] == "hyperplane" and summary["n_regions"] == 2
 
 
+def test_negative_values_given_as_a_separate_token(tmp_path, data_csv, capsys):
+    """``--hyperplane -1,0,0.2`` (argparse alone takes -1,0,0.2 for an option) gives the same model
+    as the documented ``--hyperplane=-1,0,0.2``; ``--rows -300:`` the same rows as ``--rows=-300:``."""
+    attached, spaced = tmp_path / "a.json", tmp_path / "s.json"
+    assert main(["identify", str(data_csv), *IDENTIFY, "--hyperplane=-1,0,0.2", "--rows=-300:", "--out", str(attached)]) == 0
+    first = json.loads(capsys.readouterr().out)
+    assert main(["identify", str(data_csv), *IDENTIFY, "--hyperplane", "-1,0,0.2", "--rows", "-300:", "--out", str(spaced)]) == 0
+    second = json.loads(capsys.readouterr().out)
+    assert first["n_samples"] == second["n_samples"] == 300
+    assert json.loads(attached.read_text())["regions"] == json.loads(spaced.read_text())["regions"]
+
+
 def test_cli_segmentation_names_match_the_registry():
     """`hwpts identify --segmentation` lists the registry's names without importing the library."""
     from hwpts.commands.model import SEGMENTATION_NAMES

@@ -41,7 +41,10 @@ def non_negative_int(text: str) -> int:
 
 def positive_int(text: str) -> int:
     """An integer >= 1."""
-    value = non_negative_int(text)
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
     if value < 1:
         raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}")
     return value
@@ -74,8 +77,25 @@ def output_file(text: str) -> Path | str:
         return text
     path = Path(text)
     if path.is_dir():
-        raise argparse.ArgumentTypeError(f"expected a file path, got the folder {text!r}")
+        raise argparse.ArgumentTypeError(f"expected a file path, got {text!r}, which is a folder")
     return path
+
+
+def file_with_suffix(*suffixes: str, stdout: bool = False):
+    """An argument type: a file path ending in one of ``suffixes`` (case-insensitive), not an
+    existing folder; ``-`` (standard output) too when ``stdout``."""
+    def check(text: str) -> Path | str:
+        if stdout and text == "-":
+            return text
+        if not text.strip():
+            raise argparse.ArgumentTypeError("expected a file path, got an empty string")
+        path = output_file(text)
+        if not text.lower().endswith(tuple(s.lower() for s in suffixes)):
+            what = " or ".join(suffixes) + (" (or - for standard output)" if stdout else "")
+            raise argparse.ArgumentTypeError(f"expected a {what} file name, got {text!r}")
+        return path
+    check.__name__ = "file"
+    return check
 
 
 def _finite(obj):

@@ -233,6 +233,43 @@ def _orders_to_search(args):
     return fixed, searched
 
 
+def _check_signals(inputs, output) -> None:
+    """Each signal once, and the output not among the inputs (a model of y from y(k) is no model)."""
+    seen = set()
+    for name in inputs:
+        if name in seen:
+            raise ParameterError(f"--input {name!r} is given twice; name each input column once")
+        seen.add(name)
+    if output in seen:
+        raise ParameterError(f"--output {output!r} is also an --input: the output cannot be one of the model's "
+                             f"inputs (it would predict y(k) from y(k) itself)")
+
+
+# the regions of the methods that make their own (--regions must agree or be left out)
+FIXED_REGIONS = {"average": 1, "zscore": 2}
+
+
+def _check_partition_columns(args, fixed, searched) -> None:
+    """Every ``--partition-column`` names a regressor column of some candidate structure (the
+    largest orders of the search, each delay), so a misspelt name fails at once and names the flag."""
+    from hwpts.identification.regressors import RegressorStructure
+
+    if not args.partition_column:
+        return
+    na = fixed.get("output_order", max(searched.get("output_order", [0])))
+    nb = fixed.get("input_order", max(searched.get("input_order", [1])))
+    delays = [fixed["input_delay"]] if "input_delay" in fixed else sorted(set(searched.get("input_delay", [1])))
+    names = []
+    for nk in delays:
+        structure = RegressorStructure.create(na, nb, nk, len(args.input), True, args.input, args.output)
+        names += [name for name in structure.feature_names if name not in names]
+    valid = {*names, *args.input, args.output}
+    for name in args.partition_column:
+        if name not in valid:
+            raise ParameterError(f"--partition-column {name!r} is not a regressor column; valid names are "
+                                 f"{names} or the signals {[*args.input, args.output]}")
+
+
 def cmd_identify(args) -> int:
     """``hwpts identify``: fit a PWARX model (what is not given is chosen by :class:`PWARXSearch`), write it, print a JSON summary."""
     from hwpts.identification import PWARX, PWARXSearch
@@ -242,9 +279,16 @@ def cmd_identify(args) -> int:
     from hwpts.identification.selection.search import METHOD_PARAMS
     from hwpts.io.models import save_model
 
+    _check_signals(args.input, args.output)
+    fixed, searched = _orders_to_search(args)
+    _check_partition_columns(args, fixed, searched)
+    if args.segmentation in FIXED_REGIONS and args.regions != "auto" \
+            and str(args.regions).strip() != str(FIXED_REGIONS[args.segmentation]):
+        count = FIXED_REGIONS[args.segmentation]
+        raise ParameterError(f"--regions {args.regions}: --segmentation {args.segmentation} makes {count} "
+                             f"region{'s' if count > 1 else ''}; leave --regions out or choose another method")
     data, dt = _load_dataset(args.data, args.input, args.output, args.time, args.rows)
     units = _units([*args.input, args.output], args.unit)
-    fixed, searched = _orders_to_search(args)
     if not searched:
         structure = RegressorStructure.create(fixed["output_order"], fixed["input_order"], fixed["input_delay"],
                                               len(args.input), True, args.input, args.output)
@@ -369,6 +413,7 @@ def _model_and_data(args):
         raise ParameterError(f"--input was given {len(inputs)} time(s); the model has {st.n_inputs} inputs "
                              f"{list(st.input_names)} (map each, in order)")
     output = args.output or st.output_name
+    _check_signals(inputs, output)
     data, dt = _load_dataset(args.data, inputs, output, args.time, args.rows)
     data = _check_sample_time(model, data, dt, args.data, args.resample)
     st.check_length(data.n_samples, what=repr(str(args.data)))
@@ -492,7 +537,7 @@ def register(subparsers):
     """Add the ``identify``, ``validate`` and ``predict`` sub-commands to ``subparsers``."""
     import argparse
 
-    from hwpts.commands._args import non_negative_float, non_negative_int, positive_int
+    from hwpts.commands._args import file_with_suffix, non_negative_float, non_negative_int, positive_int
 
     class ModeAction(argparse.Action):
         def __call__(self, parser, namespace, values, option_string=None):
@@ -536,7 +581,8 @@ def register(subparsers):
     p.add_argument("--unit", action="append", default=[], metavar="NAME=UNIT",
                    help="unit of a signal for plots and exports, e.g. y=mm (repeat; default: from the column "
                         "name's suffix: _rpm r/min, _v V, _bar bar, _mm mm, ...)")
-    p.add_argument("--out", required=True, metavar="MODEL.json", help="model file to write")
+    p.add_argument("--out", required=True, metavar="MODEL.json", type=file_with_suffix(".json"),
+                   help="model file to write (.json)")
     _common_data_args(p)
     p.set_defaults(handler=cmd_identify)
 
@@ -555,7 +601,7 @@ def register(subparsers):
                               description="Free-run (simulate) or one-step predictions of MODEL on DATA.")
     r.add_argument("model", metavar="MODEL.json")
     r.add_argument("data", metavar="DATA")
-    r.add_argument("--out", required=True, metavar="FILE.csv",
+    r.add_argument("--out", required=True, metavar="FILE.csv", type=file_with_suffix(".csv", ".parquet", stdout=True),
                    help="output table: .csv, .parquet, or - for CSV on standard output")
     r.add_argument("--mode", choices=["simulate", "one-step"], default="simulate", action=ModeAction,
                    help="free run (default) or one-step-ahead prediction")

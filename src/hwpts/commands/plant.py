@@ -7,7 +7,7 @@ import sys
 
 import numpy as np
 
-from hwpts.commands._args import finite_float, grid, non_negative_float, non_negative_int, output_file
+from hwpts.commands._args import file_with_suffix, finite_float, grid, non_negative_float, non_negative_int
 from hwpts.errors import ParameterError
 
 INPUT_COLUMNS = ("time_s", "valve_voltage_v", "pump_speed_rpm")
@@ -43,7 +43,7 @@ def register(subparsers) -> None:
         "and their average. Columns: valve_voltage_v, pump_speed_rpm, direction (up|down|average), "
         "motor_a_speed_rpm.",
     )
-    p.add_argument("--out", type=output_file, required=True, metavar="FILE.csv", help="output table: .csv, .parquet, or - for CSV on standard output")
+    p.add_argument("--out", type=file_with_suffix(".csv", ".parquet", stdout=True), required=True, metavar="FILE.csv", help="output table: .csv, .parquet, or - for CSV on standard output")
     p.add_argument("--voltages", type=grid, default=(1.2, 3.8, 27), metavar="START:STOP:N",
                    help="valve command grid [V] (default 1.2:3.8:27)")
     p.add_argument("--pump-speeds", type=grid, default=(200.0, 1000.0, 81), metavar="START:STOP:N",
@@ -60,7 +60,7 @@ def register(subparsers) -> None:
     source.add_argument("--case", choices=("case1", "case2", "case3", "case4"), help="one of the paper's validation cases")
     source.add_argument("--inputs", metavar="FILE.csv",
                         help="CSV with columns time_s, valve_voltage_v [V], pump_speed_rpm [r/min, the command]")
-    p.add_argument("--out", type=output_file, required=True, metavar="FILE.csv", help="output table: .csv, .parquet, or - for CSV on standard output")
+    p.add_argument("--out", type=file_with_suffix(".csv", ".parquet", stdout=True), required=True, metavar="FILE.csv", help="output table: .csv, .parquet, or - for CSV on standard output")
     p.add_argument("--noise-std", type=non_negative_float, default=None, metavar="RPM",
                    help="speed sensor noise standard deviation [r/min] (default: the test bed's 2.0)")
     p.add_argument("--seed", type=non_negative_int, default=0, metavar="N", help="noise seed (default 0)")

@@ -236,9 +236,13 @@ class ThresholdSegmenter(Segmenter):
         partition. ``columns``: the regressor columns a threshold may use (a PWARX's
         ``partition_columns``); default all."""
         self._check_regions(n_regions, X.shape[0])
-        if not 0 < self.min_share < 1 / max(n_regions, 2) or int(self.n_grid) < 2:
-            raise ParameterError(f"threshold: min_share must be in (0, 1/n_regions) and n_grid >= 2; "
-                                 f"got {self.min_share}, {self.n_grid}")
+        if not 0 < self.min_share < 1 / max(n_regions, 2):
+            most = int(np.ceil(1 / self.min_share)) - 1 if 0 < self.min_share < 1 else 0
+            raise ParameterError(f"threshold: {n_regions} regions cannot each hold min_share={self.min_share} of "
+                                 f"the rows: at most {most} regions at that share (min_share must be in "
+                                 f"(0, 1/n_regions))")
+        if int(self.n_grid) < 2:
+            raise ParameterError(f"threshold: n_grid must be >= 2, got {self.n_grid}")
         n, nf = X.shape
         allowed = range(nf) if columns is None else sorted({int(c) for c in columns})
         if self.column is None:
