@@ -47,7 +47,7 @@ def test_threshold_three_regions_and_bad_parameters():
     t = m.segmentation_info_["thresholds"]
     assert len(t) == 2 and t[0] < t[1] and m.n_regions_ == 3
     assert np.all(m.region_counts_ >= 0.03 * (len(y) - 2))
-    with pytest.raises(ParameterError, match="min_share"):
+    with pytest.raises(ParameterError, match="min_share=0.03 of the rows: at most 33 regions"):
         PWARX(1, 1, 1, n_regions=40, segmentation="threshold").fit(u, y)
     with pytest.raises(ParameterError, match="unknown regressor column"):
         PWARX(1, 1, 1, segmentation="threshold", segmentation_params={"column": "y(k-3)"}).fit(u, y)
@@ -263,6 +263,24 @@ def test_a_grid_of_cuts_is_refined_to_the_exact_thresholds():
     exact_sse, exact_thresholds = optimal_split(x, Phi, y, 4, min_rows=10, n_grid=5000)
     assert sse == pytest.approx(exact_sse, rel=1e-6)
     assert np.allclose(thresholds, exact_thresholds)
+
+
+def test_wide_regressors_get_a_coarser_grid_refined_to_the_same_cuts():
+    """On wide regressors (na = 100: 102 columns of 103 parameters) 200 cuts a column would cost
+    hours (``hwpts identify --na 100`` did not finish in 150 s); the grid is coarsened within
+    GRID_FLOPS, usual widths keep it, and the refinement still finds the exact cuts from the
+    coarsest grid."""
+    from hwpts.identification.segmentation.threshold import MIN_GRID, grid_size, optimal_split
+
+    assert grid_size(200, 9, 10) == 200 and grid_size(200, 40, 41) == 200
+    assert MIN_GRID <= grid_size(200, 102, 103) < 64
+    rng = np.random.default_rng(3)
+    x = rng.uniform(-2, 2, 3000)
+    Phi = np.column_stack([x, np.ones_like(x)])
+    y = np.select([x <= -1, x <= 0, x <= 1], [2 * x + 1, -x + 0.5, 3 * x - 1], -x + 4) + 0.02 * rng.standard_normal(x.size)
+    _, fine = optimal_split(x, Phi, y, 4, min_rows=10, n_grid=200)
+    _, coarse = optimal_split(x, Phi, y, 4, min_rows=10, n_grid=MIN_GRID)
+    assert np.allclose(coarse, fine, atol=1e-9)
 
 
 def test_threshold_keeps_to_the_partition_columns():

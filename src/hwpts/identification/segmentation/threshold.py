@@ -55,6 +55,19 @@ def threshold_partition(column: int, thresholds, n_features: int) -> RegionParti
 
 
 EXACT_ROWS = 400  # up to this many rows, every change of the threshold variable is a candidate cut
+# floating-point work allowed for the block costs of one segmentation (every column): a grid of G
+# cuts costs about G^2 / 2 solves of a p x p system per column, so on wide regressors (na = 100:
+# 102 columns, p = 103) the grid is coarsened to fit (the cuts are refined exactly afterwards);
+# at p = 10 and 9 columns the 200 default cuts use 0.3 % of it
+GRID_FLOPS = 2e10
+MIN_GRID = 16
+
+
+def grid_size(n_grid: int, n_columns: int, p: int) -> int:
+    """Candidate cuts per column within :data:`GRID_FLOPS` (at most ``n_grid``, at least
+    :data:`MIN_GRID`)."""
+    per_cut_pair = max(n_columns, 1) * (p ** 3 / 3 + p * p) / 2
+    return int(min(n_grid, max(MIN_GRID, np.sqrt(GRID_FLOPS / per_cut_pair))))
 
 
 # fingerprint of (x, Phi, y), min_rows, n_grid -> block costs (see _split_costs): one entry per
@@ -217,7 +230,7 @@ class ThresholdSegmenter(Segmenter):
     n_grid : int
         Candidate cuts on large data (more than 400 rows) when the column takes more values: this
         many quantiles (each cut then refined to its exact best position between the quantiles
-        around it).
+        around it); fewer on wide regressors, within :data:`GRID_FLOPS` (:func:`grid_size`).
     min_share : float
         Smallest share of the training rows in each region (and always more rows than parameters).
     """
@@ -260,16 +273,17 @@ class ThresholdSegmenter(Segmenter):
         Phi = structure.extend(X)
         p = Phi.shape[1]
         min_rows = max(int(np.ceil(self.min_share * n)), p + 1)
+        n_grid = grid_size(int(self.n_grid), len(columns), p)
         best = (np.inf, None, None)
         rows = fingerprint(Phi, y)  # once for every column (hashing the rows costs as much as a split)
         for c in columns:  # the columns compared by their grid optimum; the winner's cuts refined
-            sse, thresholds = optimal_split(X[:, c], Phi, y, n_regions, min_rows, int(self.n_grid),
+            sse, thresholds = optimal_split(X[:, c], Phi, y, n_regions, min_rows, n_grid,
                                             data_key=(rows, c), refine=len(columns) == 1)
             if sse < best[0]:
                 best = (sse, c, thresholds)
         sse, c, thresholds = best
         if c is not None and len(columns) > 1:
-            sse, thresholds = optimal_split(X[:, c], Phi, y, n_regions, min_rows, int(self.n_grid),
+            sse, thresholds = optimal_split(X[:, c], Phi, y, n_regions, min_rows, n_grid,
                                             data_key=(rows, c))
         if c is None:
             raise IdentificationError(
