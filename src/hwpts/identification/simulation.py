@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-__all__ = ["SimulationResult", "simulate_pwarx", "one_step_pwarx"]
+__all__ = ["SimulationResult", "simulate_pwarx", "one_step_pwarx", "free_run_sensitivity"]
 
 
 @dataclass(frozen=True)
@@ -99,6 +99,51 @@ def _simulate_kernel(u, y0, n_init, sig, lag, theta, H, g, row_start, center, bo
         yhat[k] = val
         regions[k] = chosen
     return yhat, regions, -1
+
+
+@numba.njit(cache=True, nogil=True)
+def _sensitivity_kernel(u, yhat, regions, n_init, stop, sig, lag, theta):  # pragma: no cover - compiled
+    n = u.shape[0]
+    nf = sig.shape[0]
+    q = nf + 1
+    width = theta.shape[0] * q
+    J = np.zeros((n, width))
+    for k in range(n_init, stop):
+        r = regions[k]
+        base = r * q
+        for c in range(nf):
+            if sig[c] < 0:
+                J[k, base + c] = yhat[k - lag[c]]
+            else:
+                J[k, base + c] = u[k - lag[c], sig[c]]
+        J[k, base + nf] = 1.0
+        for c in range(nf):  # the chain through the model's own past outputs
+            if sig[c] < 0 and k - lag[c] >= n_init:
+                a = theta[r, c]
+                if a != 0.0:
+                    kk = k - lag[c]
+                    for j in range(width):
+                        J[k, j] += a * J[kk, j]
+    return J
+
+
+def free_run_sensitivity(structure, theta, inputs, sim: SimulationResult) -> np.ndarray:
+    """Jacobian of the free-run output ``sim.output`` with respect to ``theta`` (flattened row by
+    row, shape ``(n, s * (n_features + 1))``), the regions held at those of the run.
+
+    The sensitivity recursion of an output-error model (Ljung 1999, section 10.3): with
+    ``yhat_k = phi_k' theta_r(k)``, ``d yhat_k / d theta = e_r(k) (x) phi_k + sum_i a_r(k),i
+    d yhat_(k-i) / d theta`` over the autoregressive lags ``i``. The switching rule is piecewise
+    constant in theta, so this is the derivative wherever it exists. Rows of the initial
+    conditions, and from a divergence on, are zero."""
+    u = np.ascontiguousarray(inputs, dtype=float)
+    if u.ndim == 1:
+        u = u[:, None]
+    sig, lag = structure.lags
+    stop = u.shape[0] if not sim.diverged else int(sim.diverged_at)
+    return _sensitivity_kernel(u, np.ascontiguousarray(sim.output, dtype=float), np.ascontiguousarray(sim.regions),
+                               min(sim.n_initial, u.shape[0]), stop, sig, lag,
+                               np.ascontiguousarray(theta, dtype=float))
 
 
 def simulate_pwarx(structure, partition, theta, inputs, initial_output, center=0.0, bound=np.inf) -> SimulationResult:
