@@ -144,8 +144,9 @@ def _run(argv: Sequence[str] | None) -> int:
     here, after the signal handlers are in place: building it imports the command modules (numpy
     and more), and a Ctrl-C or SIGTERM in that time is an interrupt like any other."""
     try:
-        args = build_parser().parse_args(_attach_negative_values(sys.argv[1:] if argv is None else argv))
-        args.command_line = shlex.join(["hwpts", *(sys.argv[1:] if argv is None else argv)])
+        given = list(sys.argv[1:] if argv is None else argv)
+        args = build_parser().parse_args(_attach_negative_values(given))
+        args.command_line = shlex.join(["hwpts", *given])
         _check_outputs(args)
         status = int(args.handler(args) or EXIT_OK)
     except BaseException as error:

@@ -53,14 +53,20 @@ def polish_free_run(structure, partition, theta, kinds, inputs, output, center, 
     target = np.concatenate([y[a + m:b] for a, b in parts])
     penalty = abs(center) + bound
 
+    last: dict = {}  # the runs of the last parameters: the Jacobian is asked where the residuals were
+
+    def runs(th):
+        """The free run of every stretch (a :class:`SimulationResult` each)."""
+        key = th.tobytes()
+        if last.get("key") != key:
+            last["key"] = key
+            last["sims"] = [simulate_pwarx(structure, partition, th, u[a:b], y[a:b], center, bound) for a, b in parts]
+        return last["sims"]
+
     def simulate(th):
         """The free run of every stretch (outputs after its initial conditions), and whether any diverged."""
-        outs, diverged = [], False
-        for a, b in parts:
-            sim = simulate_pwarx(structure, partition, th, u[a:b], y[a:b], center, bound)
-            outs.append(sim.output[m:])
-            diverged = diverged or sim.diverged
-        return np.concatenate(outs), diverged
+        sims = runs(th)
+        return np.concatenate([sim.output[m:] for sim in sims]), any(sim.diverged for sim in sims)
 
     def residuals(p):
         th = theta.copy()
@@ -76,11 +82,8 @@ def polish_free_run(structure, partition, theta, kinds, inputs, output, center, 
         """The sensitivity recursion (:func:`free_run_sensitivity`) of every stretch, stacked."""
         th = theta.copy()
         th[mask] = p
-        blocks = []
-        for a, b in parts:
-            sim = simulate_pwarx(structure, partition, th, u[a:b], y[a:b], center, bound)
-            blocks.append(free_run_sensitivity(structure, th, u[a:b], sim)[m:, columns])
-        return np.concatenate(blocks)
+        return np.concatenate([free_run_sensitivity(structure, th, u[a:b], sim)[m:, columns]
+                               for (a, b), sim in zip(parts, runs(th))])
 
     p0 = theta[mask]
     r0 = residuals(p0)

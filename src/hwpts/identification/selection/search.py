@@ -26,11 +26,12 @@ Two ways to say what to try:
      ``3 p`` rows; past 10 regions it goes on only while the held-out free-run fit itself keeps
      setting new bests (``patience`` counts in a row without one stop it; at most 40 regions): a
      smooth map approximated piece by piece asks for more pieces, a small one-step gain does not.
-     Learned segmentations label at most 5,000 rows in these fits (``PWARX(max_rows=...)``). Candidates are raced over the blocks (Maron & Moore
-     1994; successive halving over the blocks): one whose running mean falls 10 points below the
-     best so far, or whose first blocks trail the best complete candidate's same blocks by 2
-     points of free-run fit and 20 % in one-step misfit, is not scored on its remaining blocks
-     (``pruned``): it could not win. On Silverbox this cut the search from 16.6 s to 6.5 s with
+     Learned segmentations label at most 5,000 rows in these fits (``PWARX(max_rows=...)``).
+     Candidates are raced over the blocks (Maron & Moore 1994; successive halving over the
+     blocks): one whose running mean falls 10 points below the best so far, or, in the region
+     stage, whose first blocks trail the best complete candidate's same blocks by 2 points of
+     free-run fit and 20 % in one-step misfit, is not scored on its remaining blocks
+     (``pruned``): it could not win. On Silverbox this cut the search from 16.6 s to 6.6 s with
      the same choice;
   3. **choice**: the best score wins, but a candidate within ``tolerance`` points with fewer
      regions (then fewer parameters) is preferred: the simplest model the data support;
@@ -65,13 +66,11 @@ MIN_BLOCK = 10  # samples of a held-out block, beyond the initial conditions
 REGION_CAP = 10  # regions the adaptive search grows to by its usual rule (max_regions="auto") ...
 REGION_HARD_CAP = 40  # ... and at most beyond it, while each count sets a new best free-run fit
 PRUNE_MARGIN = 10.0  # points below the best so far at which a candidate's remaining blocks are skipped
-# ... and the paired rule (successive halving over the blocks): a candidate trailing the leader (the
-# best complete candidate so far) on the same first blocks by 2 points of free-run fit AND by 20 %
-# in one-step misfit is not scored on its remaining blocks
-PAIRED_MARGIN = (2.0, 1.2)
-# a method trailing the leader of its region count by 2 points of free-run fit AND by 20 % in
-# one-step misfit (100 - fit), `patience` counts in a row, is not tried with more regions
-DROP_MARGIN = (2.0, 1.2)
+# "trailing" (:func:`_behind`): 2 points of free-run fit AND 20 % more one-step misfit (100 - fit)
+# than the leader. A candidate trailing the best complete candidate on the same first blocks is not
+# scored on its remaining blocks (successive halving over the blocks); a method trailing the leader
+# of its region count, `patience` counts in a row, is not tried with more regions
+TRAIL_MARGIN = (2.0, 1.2)
 
 # methods' settings in the adaptive search: thresholds on any column, restarts as the data need
 METHOD_PARAMS = {"threshold": {"column": None}, "alternating": {"n_restarts": "auto"}}
@@ -118,9 +117,15 @@ def _score_split(estimator, params, u, y, train, test, names=None, output_name=N
     return sim.score(y[start:stop]), one, int(model.n_regions_)
 
 
+def _behind(free, one, lead_free, lead_one) -> bool:
+    """Whether fits (free run ``free``, one-step ``one``, %) trail the leader's by
+    :data:`TRAIL_MARGIN`: the free run by 2 points and the one-step misfit by 20 %, both."""
+    return bool(free < lead_free - TRAIL_MARGIN[0] and 100.0 - one > TRAIL_MARGIN[1] * (100.0 - lead_one))
+
+
 def _trails(fits, ones, leader) -> bool:
     """Whether a candidate's first blocks (free-run ``fits``, one-step ``ones``) trail the
-    ``leader`` row's same blocks by :data:`PAIRED_MARGIN` (free run and one-step misfit both)."""
+    ``leader`` row's same blocks (:func:`_behind` on the means)."""
     if not leader:
         return False
     j = len(fits)
@@ -128,9 +133,8 @@ def _trails(fits, ones, leader) -> bool:
     lead_ones = leader.get("split_one_step_fits_percent") or []
     if len(lead_fits) < j or len(lead_ones) < j:
         return False
-    free, one = float(np.mean(fits)), float(np.mean(ones))
-    return bool(free < float(np.mean(lead_fits[:j])) - PAIRED_MARGIN[0]
-                and 100.0 - one > PAIRED_MARGIN[1] * (100.0 - float(np.mean(lead_ones[:j]))))
+    return _behind(float(np.mean(fits)), float(np.mean(ones)), float(np.mean(lead_fits[:j])),
+                   float(np.mean(lead_ones[:j])))
 
 
 def _evaluate(estimator, params, u, y, splits, prune_below=-np.inf, names=None, output_name=None, leader=None):
@@ -475,7 +479,7 @@ class PWARXSearch(BaseEstimator):
 
     def _still_racing(self, rows, active, behind):
         """The methods tried with more regions: a method that trails the best of this region count
-        by ``DROP_MARGIN`` (2 points of free-run fit and 20 % more one-step misfit), or whose model
+        by ``TRAIL_MARGIN`` (2 points of free-run fit and 20 % more one-step misfit), or whose model
         diverged or was pruned while another method's scored, ``patience`` counts in a row, stops
         (its growth would cost the most and not win)."""
         if len(active) < 2:
@@ -494,8 +498,7 @@ class PWARXSearch(BaseEstimator):
                 keep.append(m)  # failed here: no evidence either way (a method may fail with few
                 continue        # regions and win with more)
             else:
-                trails = (free[m] < lead_free - DROP_MARGIN[0]
-                          and 100.0 - one.get(m, -np.inf) > DROP_MARGIN[1] * (100.0 - lead_one))
+                trails = _behind(free[m], one.get(m, -np.inf), lead_free, lead_one)
             behind[m] = behind[m] + 1 if trails else 0
             if behind[m] < max(int(self.patience), 1):
                 keep.append(m)
