@@ -3,7 +3,7 @@
 import warnings
 
 import numpy as np
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from hwpts.identification import PWARX, region_accuracy
@@ -38,6 +38,7 @@ def _stable_theta(rng, n_features, na):
 
 @SETTINGS
 @given(seed=st.integers(0, 2**16), na=st.integers(0, 2), threshold=st.floats(-0.3, 0.3))
+@example(seed=3974, na=2, threshold=-0.0390625)  # four fixed starts all missed it; "auto" restarts find it
 def test_noise_free_pwarx_is_recovered(seed, na, threshold):
     """Two modes split by an input threshold; noise-free data -> exact parameters and regions."""
     rng = np.random.default_rng(seed)

@@ -211,7 +211,9 @@ class AlternatingSegmenter(Segmenter):
         best objective so far, the chance that one start succeeds is about ``p = m / r``, and
         ``log(0.01) / log(1 - p)`` starts find the best minimum with 99 % probability; starts run
         until that many were made (at least 3, at most ``AUTO_MAX_RESTARTS``; fewer on large data,
-        where a single start already sees enough samples to succeed).
+        where a single start already sees enough samples to succeed). The default: a fixed 4 left
+        a noise-free two-mode system unrecovered about once in 1,000 random draws (all four starts
+        in one 0.18 minimum, the tenth start at the exact one).
     gamma : float
         Weight of the region-separability term (in units of the residual variance).
     max_iter : int
@@ -224,7 +226,7 @@ class AlternatingSegmenter(Segmenter):
     name = "alternating"
     learns_partition = True
 
-    def __init__(self, *, n_restarts: int | str = 4, gamma: float = 1.0, max_iter: int = 50,
+    def __init__(self, *, n_restarts: int | str = "auto", gamma: float = 1.0, max_iter: int = 50,
                  anneal: tuple = ()):
         self.n_restarts = n_restarts
         self.gamma = gamma
