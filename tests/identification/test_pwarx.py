@@ -327,7 +327,7 @@ def test_search_and_polish_run_blas_single_threaded(monkeypatch):
     assert all(n == 1 for _, n in seen)
     seen.clear()
     PWARX(1, 1, 1, n_regions=2, segmentation="threshold", polish=True).fit(u, y)  # the polish alone too
-    assert seen == [("polish", 1)]
+    assert seen == [("polish", 1)] * 2  # a short record: trust region and Levenberg-Marquardt
     assert polish_free_run is polish_module.polish_free_run
 
 
@@ -389,3 +389,33 @@ def test_free_run_sensitivity_is_the_derivative_of_the_free_run(seed):
         same = (a.regions == sim.regions) & (b.regions == sim.regions)  # a switch moved: no derivative there
         numeric = (a.output - b.output) / (2 * eps)
         assert np.allclose(J[same, j], numeric[same], rtol=1e-4, atol=1e-6 * max(1.0, np.abs(numeric).max()))
+
+
+def test_polish_keeps_the_better_of_two_descents_on_short_records(monkeypatch):
+    """On a short record the polish runs trf and lm from the same start and keeps the lower
+    training cost: never worse than trf alone; long records run trf only."""
+    import hwpts.identification.polish as polish_module
+
+    from scipy.optimize import least_squares
+
+    methods = []
+
+    def spy(*args, **kwargs):
+        methods.append(kwargs["method"])
+        return least_squares(*args, **kwargs)
+
+    monkeypatch.setattr("scipy.optimize.least_squares", spy)
+    for seed in range(4):
+        d = make_system(5, rng=seed, n=400)
+        model = PWARX(2, 2, 1, n_regions=3, segmentation="alternating", random_state=seed).fit(d.inputs, d.output)
+        args = (model.structure_, model.partition_, model.theta_, ("affine",) * model.n_regions_, d.inputs,
+                d.output, *model.divergence_band())
+        methods.clear()
+        _, both = polish_module.polish_free_run(*args)
+        assert methods == ["trf", "lm"] and both["method"] in ("trf", "lm")
+        monkeypatch.setattr(polish_module, "SECOND_SOLVER_ROWS", 0)
+        methods.clear()
+        _, trf = polish_module.polish_free_run(*args)
+        monkeypatch.setattr(polish_module, "SECOND_SOLVER_ROWS", 10_000)
+        assert methods == ["trf"]
+        assert both["final_sse"] <= trf["final_sse"] * (1 + 1e-12)

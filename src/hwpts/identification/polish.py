@@ -21,6 +21,15 @@ from threadpoolctl import threadpool_limits
 
 from hwpts.identification.simulation import free_run_sensitivity, simulate_pwarx
 
+# Records up to this many simulated samples get a second local descent (Levenberg-Marquardt beside
+# the trust-region reflective one, from the same start; the lower cost kept). The simulation error
+# of a short record has several minima close to the least-squares start, and one descent lands in
+# one of them by the path it takes: on the hydraulic actuator's 512 training samples the polish
+# of one cross-validation fit ends at SSE 49.8 by trf and 13.0 by lm (on four other fits trf is the
+# better one), and the real-data benchmark's test fit goes 49.1 -> 58.7 %. On long records (Silverbox,
+# EMPS: 25,000-30,000 samples) both reach the same model and the second costs as much as the first.
+SECOND_SOLVER_ROWS = 10_000
+
 
 def _stretches(n: int, m: int, breaks) -> list[tuple[int, int]]:
     """``[start, stop)`` of the stretches between ``breaks`` long enough to simulate (more than
@@ -91,16 +100,26 @@ def polish_free_run(structure, partition, theta, kinds, inputs, output, center, 
     info = {"initial_sse": cost0}
     if p0.size == 0:
         return theta, info
-    try:
-        # one BLAS thread: the trust-region step's SVD of the (n x p) Jacobian (p tens) is fastest
-        # single-threaded, and threaded BLAS beside another job spin-waits (measured 1.2 s -> 0.02 s
-        # per SVD of 30,000 x 45 on a busy 2-core machine)
-        with threadpool_limits(limits=1, user_api="blas"):
-            res = least_squares(residuals, p0, jac=jacobian, method="trf", x_scale="jac",
-                                max_nfev=max_nfev or 30 * (p0.size + 1))
-    except (ValueError, np.linalg.LinAlgError) as error:  # pragma: no cover - defensive
-        info["failed"] = str(error)
+    nfev = max_nfev or 30 * (p0.size + 1)
+    # short records: a second descent (Levenberg-Marquardt) from the same start, the lower cost kept
+    methods = ("trf", "lm") if target.size <= SECOND_SOLVER_ROWS else ("trf",)
+    best = None
+    for method in methods:
+        try:
+            # one BLAS thread: the trust-region step's SVD of the (n x p) Jacobian (p tens) is fastest
+            # single-threaded, and threaded BLAS beside another job spin-waits (measured 1.2 s -> 0.02 s
+            # per SVD of 30,000 x 45 on a busy 2-core machine)
+            with threadpool_limits(limits=1, user_api="blas"):
+                res = least_squares(residuals, p0, jac=jacobian, method=method, x_scale="jac", max_nfev=nfev)
+        except (ValueError, np.linalg.LinAlgError) as error:  # pragma: no cover - defensive
+            info["failed"] = str(error)
+            continue
+        if best is None or res.cost < best.cost:
+            best = res
+            info["method"] = method
+    if best is None:  # pragma: no cover - defensive
         return theta, info
+    res = best
     th = theta.copy()
     th[mask] = res.x
     out, diverged = simulate(th)
