@@ -16,8 +16,8 @@ Measured in the same run (BENCHMARKS.md):
   oracle alone over 50 x 20 further pairs (how often a perfect-labels estimator clears 95 %);
 - free-run simulation of 10^6 samples;
 - real data (when ``../shared/data`` or ``$HWPTS_DATA_DIR`` exists): pick_and_place and the
-  hydraulic actuator, everything selected on the training part only (blocked cross-validation of
-  the free-run fit, `select_model(scheme="blocked")`).
+  hydraulic actuator, a fixed grid selected on the training part only (blocked cross-validation of
+  the free-run fit, :class:`PWARXSearch` with ``cv=5``); the default search is ``benchmarks real``.
 """
 
 from __future__ import annotations
@@ -218,11 +218,16 @@ def bench_simulation(lines):
 
 
 def bench_real(lines):
-    from hwpts.identification import PWARX
-    from hwpts.identification.selection import expand_grid, select_model
+    """Fixed grids on pick_and_place and the hydraulic actuator, chosen by :class:`PWARXSearch`
+    (5 contiguous blocks of the training record, each simulated in free run by the candidate fitted
+    on the other four; the best mean wins outright, as ``GridSearchCV``). The default search
+    (orders, method and regions chosen) is ``python -m benchmarks real``."""
+    from hwpts.identification import PWARX, PWARXSearch
+    from hwpts.identification.selection import expand_grid
     from hwpts.io.datasets import read_table
 
     root = Path(os.environ.get("HWPTS_DATA_DIR", HERE.parent.parent / "shared" / "data"))
+    base = PWARX(input_delay=1, random_state=0)
     pp = root / "pick_and_place" / "pick_and_place_400Hz.csv"
     if pp.exists():
         c = read_table(pp)
@@ -238,13 +243,11 @@ def bench_real(lines):
                 grid += expand_grid({"output_order": [na], "input_order": [nb], "segmentation": ["threshold"],
                                      "n_regions": [2, 3], "polish": [False, True]})
         t0 = time.perf_counter()
-        # blocked cross-validation: 5 contiguous blocks of the training record, each simulated in free
-        # run by the candidate fitted on the other four
-        model, table = select_model(utr, ytr, grid, {"input_delay": 1, "random_state": 0}, n_folds=5,
-                                    scheme="blocked", n_jobs=2)
-        chosen = next(r["params"] for r in table if r.get("chosen"))
-        lines.append(f"pick_and_place: test free-run fit {model.score(ute, yte):.2f} % (plain ARX {arx:.2f} %), "
-                     f"chosen on training only {chosen} from {len(table)} candidates in {time.perf_counter() - t0:.0f} s")
+        search = PWARXSearch(base, grid, cv=5, try_polish=False, tolerance=0.0).fit(utr, ytr)
+        elapsed = time.perf_counter() - t0
+        lines.append(f"pick_and_place: test free-run fit {search.score(ute, yte):.2f} % (plain ARX {arx:.2f} %), "
+                     f"chosen on training only {search.best_params_} from {len(search.cv_results_)} candidates "
+                     f"in {elapsed:.0f} s")
     else:
         lines.append(f"pick_and_place: skipped, {pp} not found")
     act = root / "hydraulic_actuator" / "actuator.csv"
@@ -258,12 +261,10 @@ def bench_real(lines):
             grid += expand_grid({"output_order": [na], "input_order": [nb],
                                  "segmentation": ["average", "kmeans", "clustering", "alternating"],
                                  "n_regions": [2, 3], "polish": [False, True]})
-        model, table = select_model(utr, ytr, grid, {"input_delay": 1, "random_state": 0}, n_folds=5,
-                                    scheme="blocked", n_jobs=2)
-        chosen = next(r["params"] for r in table if r.get("chosen"))
-        rejected = sum(r["rejected"] is not None for r in table)
-        lines.append(f"hydraulic_actuator: test free-run fit {model.score(ute, yte):.2f} % (plain ARX {arx:.2f} %), "
-                     f"chosen {chosen}; {rejected} of {len(table)} candidates rejected (diverged)")
+        search = PWARXSearch(base, grid, cv=5, try_polish=False).fit(utr, ytr)
+        diverged = sum(bool(r["diverged"]) for r in search.cv_results_)
+        lines.append(f"hydraulic_actuator: test free-run fit {search.score(ute, yte):.2f} % (plain ARX {arx:.2f} %), "
+                     f"chosen {search.best_params_}; {diverged} of {len(search.cv_results_)} candidates diverged")
     else:
         lines.append(f"hydraulic_actuator: skipped, {act} not found")
 
