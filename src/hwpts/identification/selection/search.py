@@ -72,8 +72,9 @@ PRUNE_MARGIN = 10.0  # points below the best so far at which a candidate's remai
 # of its region count, `patience` counts in a row, is not tried with more regions
 TRAIL_MARGIN = (2.0, 1.2)
 
-# methods' settings in the adaptive search: thresholds on any column, restarts as the data need
-METHOD_PARAMS = {"threshold": {"column": None}, "alternating": {"n_restarts": "auto"}}
+# methods' settings in the adaptive search: thresholds on any column (the alternating segmenter's
+# own default, restarts as the data need, is what the search uses)
+METHOD_PARAMS = {"threshold": {"column": None}}
 
 
 def expand_grid(grid) -> list[dict]:
