@@ -405,6 +405,7 @@ def test_polish_keeps_the_better_of_two_descents_on_short_records(monkeypatch):
         return least_squares(*args, **kwargs)
 
     monkeypatch.setattr("scipy.optimize.least_squares", spy)
+    rows = polish_module.SECOND_SOLVER_ROWS
     for seed in range(4):
         d = make_system(5, rng=seed, n=400)
         model = PWARX(2, 2, 1, n_regions=3, segmentation="alternating", random_state=seed).fit(d.inputs, d.output)
@@ -416,6 +417,6 @@ def test_polish_keeps_the_better_of_two_descents_on_short_records(monkeypatch):
         monkeypatch.setattr(polish_module, "SECOND_SOLVER_ROWS", 0)
         methods.clear()
         _, trf = polish_module.polish_free_run(*args)
-        monkeypatch.setattr(polish_module, "SECOND_SOLVER_ROWS", 10_000)
+        monkeypatch.setattr(polish_module, "SECOND_SOLVER_ROWS", rows)
         assert methods == ["trf"]
         assert both["final_sse"] <= trf["final_sse"] * (1 + 1e-12)

@@ -245,10 +245,6 @@ def _check_signals(inputs, output) -> None:
                              f"inputs (it would predict y(k) from y(k) itself)")
 
 
-# the regions of the methods that make their own (--regions must agree or be left out)
-FIXED_REGIONS = {"average": 1, "zscore": 2}
-
-
 def _check_partition_columns(args, fixed, searched) -> None:
     """Every ``--partition-column`` names a regressor column of some candidate structure (the
     largest orders of the search, each delay), so a misspelt name fails at once and names the flag."""
@@ -276,15 +272,16 @@ def cmd_identify(args) -> int:
     from hwpts.identification.partition import Hyperplane
     from hwpts.identification.regressors import RegressorStructure
     from hwpts.identification.selection import DEFAULT_METHODS
+    from hwpts.identification.segmentation import SEGMENTATION_METHODS
     from hwpts.identification.selection.search import METHOD_PARAMS
     from hwpts.io.models import save_model
 
     _check_signals(args.input, args.output)
     fixed, searched = _orders_to_search(args)
     _check_partition_columns(args, fixed, searched)
-    if args.segmentation in FIXED_REGIONS and args.regions != "auto" \
-            and str(args.regions).strip() != str(FIXED_REGIONS[args.segmentation]):
-        count = FIXED_REGIONS[args.segmentation]
+    count = getattr(SEGMENTATION_METHODS.get(args.segmentation), "fixed_regions", None)
+    if count is not None and args.regions != "auto" and str(args.regions).strip() != str(count):
+        # a method that makes its own regions: --regions must agree or be left out
         raise ParameterError(f"--regions {args.regions}: --segmentation {args.segmentation} makes {count} "
                              f"region{'s' if count > 1 else ''}; leave --regions out or choose another method")
     data, dt = _load_dataset(args.data, args.input, args.output, args.time, args.rows)

@@ -12,6 +12,7 @@ class AverageSegmenter(Segmenter):
 
     name = "average"
     uses_n_regions = False
+    fixed_regions = 1
 
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
         """One region holding every row: a single ARX model."""

@@ -48,6 +48,8 @@ class Segmenter(BaseEstimator):
     name = "base"
     #: whether the method takes the number of regions from the caller
     uses_n_regions = True
+    #: the number of regions a method that does not take it always makes (None: it takes it)
+    fixed_regions: int | None = None
     #: whether the estimator learns the partition from the labels (then it may segment a subsample)
     learns_partition = False
     #: whether the method draws its own fixed partition on regressor columns, so that

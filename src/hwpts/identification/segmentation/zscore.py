@@ -25,6 +25,7 @@ class ZScoreSegmenter(Segmenter):
     """
     name = "zscore"
     uses_n_regions = False
+    fixed_regions = 2
 
     def __init__(self, *, threshold: float = 0.0):
         self.threshold = threshold
