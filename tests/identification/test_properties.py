@@ -97,3 +97,47 @@ def test_free_run_divergence_is_reported_not_scored():
         score = model.score(u, np.linspace(-1, 1, 200))
     assert np.isnan(score)
     assert any("left the band" in str(w.message) for w in caught)
+
+
+@SETTINGS
+@given(cuts=st.lists(st.floats(-2, 2, allow_nan=False).map(lambda v: round(v, 2)), min_size=1, max_size=6,
+                     unique=True),
+       n_features=st.integers(1, 4), column=st.integers(0, 3), seed=st.integers(0, 2**16))
+def test_threshold_partition_search_is_the_inequality_rule(cuts, n_features, column, seed):
+    """A threshold partition predicts by one sorted search of its column; that is the first
+    polyhedron whose inequalities H x + g <= 0 hold (eq. 8-9), boundaries included."""
+    from hwpts.identification.segmentation.threshold import threshold_partition
+
+    column = column % n_features
+    t = sorted(cuts)
+    partition = threshold_partition(column, t, n_features)
+    assert partition.cuts is not None
+    rng = np.random.default_rng(seed)
+    X = rng.uniform(-3, 3, (300, n_features)).round(2)
+    X[: len(t), column] = t  # rows exactly on a boundary go to the lower region
+    fast = partition.predict(X)
+    partition.cuts = None
+    np.testing.assert_array_equal(fast, partition.predict(X))
+
+
+@SETTINGS
+@given(n=st.integers(12, 300), n_features=st.integers(1, 5), constant=st.booleans(),
+       ridge=st.sampled_from([0.0, 1e-3]), seed=st.integers(0, 2**16))
+def test_local_covariance_is_sigma2_times_the_inverse_normal_matrix(n, n_features, constant, ridge, seed):
+    """Each region's parameter covariance is sigma^2 (Phi' Phi)^-1 (eq. 17), sigma^2 = RSS / (n - p),
+    whichever path its least squares took (normal equations or SVD)."""
+    from hwpts.identification.local_models import fit_local_models
+
+    rng = np.random.default_rng(seed)
+    X = rng.standard_normal((n, n_features)) * 10.0 ** rng.uniform(-3, 3, n_features)
+    y = rng.standard_normal(n)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        models = fit_local_models(X, y, np.zeros(n, dtype=np.int64), 1, constant, ridge=ridge)
+    Phi = np.hstack([X, np.ones((n, 1))]) if constant else X
+    p = Phi.shape[1]
+    theta = models.theta[0] if constant else models.theta[0, :-1]
+    r = y - Phi @ theta
+    expected = float(r @ r) / (n - p) * np.linalg.inv(Phi.T @ Phi)
+    got = models.covariance[0] if constant else models.covariance[0, :-1, :-1]
+    np.testing.assert_allclose(got, expected, rtol=1e-6, atol=1e-12 * np.abs(expected).max())

@@ -306,3 +306,28 @@ def test_the_cost_cache_is_bounded_by_bytes_too():
     assert list(cache) == [2, 3, 4] and cache._bytes == 2400
     cache.clear()
     assert cache._bytes == 0 and not cache
+
+
+def test_columns_screened_on_a_coarse_grid_keep_the_switching_column(monkeypatch):
+    """On large data the columns are first scored on a coarse grid and only the best two on the
+    full one: the switching column and its threshold are those of scoring every column fully."""
+    from hwpts.identification.segmentation import threshold as T
+
+    rng = np.random.default_rng(7)
+    n = 4000
+    u = rng.uniform(-1, 1, (n, 3))
+    y = np.zeros(n)
+    for k in range(1, n):
+        y[k] = (0.6 * y[k - 1] + u[k - 1, 0] if u[k - 1, 2] <= -0.25 else -0.2 * y[k - 1] + 0.5 * u[k - 1, 1] + 1.0) \
+            + 0.01 * rng.standard_normal()
+
+    def fit():
+        m = PWARX(2, 2, 1, n_regions=2, segmentation="threshold", segmentation_params={"column": None})
+        return m.fit(u, y).segmentation_info_
+
+    screened = fit()
+    monkeypatch.setattr(T, "SCREEN_KEEP", 100)  # every column on the full grid
+    full = fit()
+    assert screened["column"] == full["column"] == "u3(k-1)"
+    assert screened["thresholds"] == full["thresholds"]
+    assert abs(screened["thresholds"][0] + 0.25) < 0.02

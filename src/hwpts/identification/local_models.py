@@ -71,28 +71,61 @@ class LocalModels:
         return y[:, None] - (X @ self.theta[:, :-1].T + self.theta[:, -1])
 
 
-def solve_region(X: np.ndarray, y: np.ndarray, constant: bool, ridge: float = 0.0) -> tuple[np.ndarray, float]:
-    """Least squares (eq. 17) of one region on column-scaled regressors; returns (theta, cond)."""
+def _normal_equations(X: np.ndarray, y: np.ndarray, constant: bool):
+    """``(G, b, scale)``: the normal equations ``A' A``, ``A' y`` of the column-scaled regressors
+    ``A = [X 1] / scale`` (``scale`` the root mean square of each column, 1 for a zero column),
+    accumulated from ``X`` without forming ``[X 1]`` (one product ``X' X``)."""
     n, nf = X.shape
-    Phi = np.hstack([X, np.ones((n, 1))]) if constant else X
-    scale = np.sqrt(np.mean(Phi**2, axis=0)) if n else np.ones(Phi.shape[1])
+    sq = np.einsum("ij,ij->j", X, X)
+    scale = np.sqrt(sq / n) if n else np.ones(nf)
+    if constant:
+        scale = np.append(scale, 1.0)
     scale[scale == 0] = 1.0
-    A = Phi / scale
-    b = y
-    if ridge > 0:
-        pen = np.sqrt(ridge * max(n, 1)) * np.eye(A.shape[1])
-        if constant:
-            pen = pen[:-1]
-        A = np.vstack([A, pen])
-        b = np.concatenate([y, np.zeros(pen.shape[0])])
-    coef = None
-    if A.shape[0] >= 4 * A.shape[1]:  # tall: normal equations (fast), if well conditioned
-        G = A.T @ A
-        ev = np.linalg.eigvalsh(G)
+    XtX = X.T @ X
+    Xty = X.T @ y
+    if constant:
+        total = X.sum(axis=0)
+        G = np.empty((nf + 1, nf + 1))
+        G[:nf, :nf] = XtX
+        G[:nf, nf] = G[nf, :nf] = total
+        G[nf, nf] = n
+        b = np.append(Xty, y.sum())
+    else:
+        G, b = XtX, Xty
+    return G / np.outer(scale, scale), b / scale, scale
+
+
+def _fit_region(X: np.ndarray, y: np.ndarray, constant: bool, ridge: float = 0.0):
+    """``(theta, cond, G, scale)``: least squares of one region (:func:`solve_region`), with the
+    column-scaled normal matrix ``G`` (without the ridge; ``None`` when the SVD path was taken) that
+    :func:`parameter_covariance` would compute again."""
+    n, nf = X.shape
+    p = nf + int(constant)
+    coef = G = None
+    rows = n + (p - int(constant) if ridge > 0 else 0)
+    if rows >= 4 * p:  # tall: normal equations (fast), if well conditioned
+        G, b, scale = _normal_equations(X, y, constant)
+        M = G
+        if ridge > 0:  # the penalty rows sqrt(ridge n) I (offset free) add ridge n to the diagonal
+            M = G + ridge * max(n, 1) * np.diag(np.r_[np.ones(nf), np.zeros(int(constant))])
+        ev = np.linalg.eigvalsh(M)
         cond = float(np.sqrt(ev[-1] / ev[0])) if ev[0] > 0 else float("inf")
         if cond < 1e6:
-            coef = np.linalg.solve(G, A.T @ b)
+            coef = np.linalg.solve(M, b)
+        else:
+            G = None
     if coef is None:  # SVD least squares: robust to rank deficiency
+        Phi = np.hstack([X, np.ones((n, 1))]) if constant else X
+        scale = np.sqrt(np.mean(Phi**2, axis=0)) if n else np.ones(Phi.shape[1])
+        scale[scale == 0] = 1.0
+        A = Phi / scale
+        b = y
+        if ridge > 0:
+            pen = np.sqrt(ridge * max(n, 1)) * np.eye(A.shape[1])
+            if constant:
+                pen = pen[:-1]
+            A = np.vstack([A, pen])
+            b = np.concatenate([y, np.zeros(pen.shape[0])])
         coef, _, rank, sv = np.linalg.lstsq(A, b, rcond=None)
         cond = float(sv[0] / sv[-1]) if sv.size and sv[-1] > 0 else float("inf")
     coef = coef / scale
@@ -101,28 +134,36 @@ def solve_region(X: np.ndarray, y: np.ndarray, constant: bool, ridge: float = 0.
         theta[:] = coef
     else:
         theta[:nf] = coef
+    return theta, cond, G, scale
+
+
+def solve_region(X: np.ndarray, y: np.ndarray, constant: bool, ridge: float = 0.0) -> tuple[np.ndarray, float]:
+    """Least squares (eq. 17) of one region on column-scaled regressors; returns (theta, cond)."""
+    theta, cond, _, _ = _fit_region(X, y, constant, ridge)
     return theta, cond
 
 
-def parameter_covariance(X: np.ndarray, y: np.ndarray, theta: np.ndarray, constant: bool) -> np.ndarray:
+def parameter_covariance(X: np.ndarray, y: np.ndarray, theta: np.ndarray, constant: bool,
+                         _normal=None) -> np.ndarray:
     """Covariance ``sigma^2 (Phi' Phi)^-1`` of one region's least-squares parameters (eq. 17).
 
     ``sigma^2 = RSS / (n - p)``, the residual variance with ``p`` parameters; the matrix is over
     ``[x' 1]`` (offset last; its row and column are zero without a constant term). ``nan`` when the
-    region has no more samples than parameters.
+    region has no more samples than parameters. (``_normal``: the ``(G, scale)`` least squares
+    already formed for these rows.)
     """
     n, nf = X.shape
     cov = np.full((nf + 1, nf + 1), np.nan)
-    Phi = np.hstack([X, np.ones((n, 1))]) if constant else X
-    p = Phi.shape[1]
+    p = nf + int(constant)
     if n <= p:
         return cov
     r = y - X @ theta[:nf] - theta[nf]
     sigma2 = float(r @ r) / (n - p)
-    scale = np.sqrt(np.mean(Phi**2, axis=0))
-    scale[scale == 0] = 1.0
-    A = Phi / scale
-    inv = np.linalg.pinv(A.T @ A) / np.outer(scale, scale)
+    if _normal is None or _normal[0] is None:
+        G, _, scale = _normal_equations(X, y, constant)
+    else:
+        G, scale = _normal
+    inv = np.linalg.pinv(G) / np.outer(scale, scale)
     if constant:
         cov[:] = sigma2 * inv
     else:
@@ -180,16 +221,16 @@ def fit_local_models(X: np.ndarray, y: np.ndarray, labels: np.ndarray, n_regions
                 f"region {i + 1} has {counts[i]} samples for {n_par} parameters; its parameters are "
                 f"the minimum-norm least-squares solution", RegionWarning, stacklevel=2,
             )
-        theta[i], cond[i] = solve_region(X[mask], y[mask], constant, ridge)
         Xi, yi = X[mask], y[mask]
+        theta[i], cond[i], G, scale = _fit_region(Xi, yi, constant, ridge)
         if trim is not None and counts[i] > 2 * n_par:
             r = yi - Xi @ theta[i, :-1] - theta[i, -1]
             sd = 1.4826 * np.median(np.abs(r - np.median(r)))
             keep = np.abs(r) <= trim * sd
             if sd > 0 and n_par < keep.sum() < keep.size:
                 Xi, yi = Xi[keep], yi[keep]
-                theta[i], cond[i] = solve_region(Xi, yi, constant, ridge)
-        cov[i] = parameter_covariance(Xi, yi, theta[i], constant)
+                theta[i], cond[i], G, scale = _fit_region(Xi, yi, constant, ridge)
+        cov[i] = parameter_covariance(Xi, yi, theta[i], constant, _normal=(G, scale))
         if warn and counts[i] >= n_par and cond[i] > ILL_CONDITIONED:
             warnings.warn(
                 f"region {i + 1}: least squares is ill-conditioned (condition number {cond[i]:.3g}); "

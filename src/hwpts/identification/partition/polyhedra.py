@@ -59,6 +59,9 @@ class RegionPartition:
                 raise ParameterError(f"region {i + 1}: non-finite polyhedron coefficients")
         self.kind = kind
         self.scores = None  # (W, b) of the linear classifier when learned: s(x) = W x + b
+        # (column, ascending thresholds) when region i is {t_(i-1) < x_column <= t_i} (a threshold
+        # partition): predict is then one sorted search of a column instead of every inequality
+        self.cuts = None
 
     def log_proba(self, X: np.ndarray) -> np.ndarray | None:
         """Log class probabilities (softmax of the classifier scores), or None if not learned."""
@@ -102,6 +105,13 @@ class RegionPartition:
                 raise DataError(f"regressors must have shape (n, {self.n_features}); got {X.shape}")
             W, b = self.scores
             return np.argmax(X @ W.T + b, axis=1).astype(np.int64)
+        if self.cuts is not None:
+            X = np.asarray(X, dtype=float)
+            if X.ndim == 2 and X.shape[1] == self.n_features:
+                column, t = self.cuts
+                x = X[:, column]
+                if np.all(np.isfinite(x)):  # the unique region holding x: how many cuts lie below it
+                    return np.searchsorted(t, x, side="left").astype(np.int64)
         v = self.violations(X)
         inside = v <= 0.0
         first = np.argmax(inside, axis=1)

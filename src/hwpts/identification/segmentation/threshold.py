@@ -51,7 +51,10 @@ def threshold_partition(column: int, thresholds, n_features: int) -> RegionParti
             offs.append(-t[i])
         H.append(np.array(rows).reshape(-1, n_features))
         g.append(np.array(offs))
-    return RegionPartition(H, g, kind="thresholds")
+    partition = RegionPartition(H, g, kind="thresholds")
+    if all(a < b for a, b in zip(t[:-1], t[1:])):
+        partition.cuts = (int(column), np.array(t))
+    return partition
 
 
 EXACT_ROWS = 400  # up to this many rows, every change of the threshold variable is a candidate cut
@@ -61,6 +64,12 @@ EXACT_ROWS = 400  # up to this many rows, every change of the threshold variable
 # at p = 10 and 9 columns the 200 default cuts use 0.3 % of it
 GRID_FLOPS = 2e10
 MIN_GRID = 16
+# With more than SCREEN_KEEP columns to try on large data, every column is first scored on a grid of
+# SCREEN_GRID cuts (a sixteenth of the block costs of 200) and only the SCREEN_KEEP best are scored
+# on the full grid: on Silverbox (8 columns, 3 folds of 20,000 rows) the first split took 0.50 s of
+# which 0.49 s were the full-grid block costs of every column
+SCREEN_GRID = 50
+SCREEN_KEEP = 2
 
 
 def grid_size(n_grid: int, n_columns: int, p: int) -> int:
@@ -276,6 +285,11 @@ class ThresholdSegmenter(Segmenter):
         n_grid = grid_size(int(self.n_grid), len(columns), p)
         best = (np.inf, None, None)
         rows = fingerprint(Phi, y)  # once for every column (hashing the rows costs as much as a split)
+        if n > EXACT_ROWS and n_grid > SCREEN_GRID and len(columns) > SCREEN_KEEP:
+            # the columns screened on a coarse grid; the best SCREEN_KEEP go on to the full grid
+            coarse = [optimal_split(X[:, c], Phi, y, n_regions, min_rows, SCREEN_GRID, data_key=(rows, c),
+                                    refine=False)[0] for c in columns]
+            columns = [columns[i] for i in np.argsort(coarse, kind="stable")[:SCREEN_KEEP]]
         for c in columns:  # the columns compared by their grid optimum; the winner's cuts refined
             sse, thresholds = optimal_split(X[:, c], Phi, y, n_regions, min_rows, n_grid,
                                             data_key=(rows, c), refine=len(columns) == 1)
