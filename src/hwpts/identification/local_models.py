@@ -71,61 +71,37 @@ class LocalModels:
         return y[:, None] - (X @ self.theta[:, :-1].T + self.theta[:, -1])
 
 
-def _normal_equations(X: np.ndarray, y: np.ndarray, constant: bool):
-    """``(G, b, scale)``: the normal equations ``A' A``, ``A' y`` of the column-scaled regressors
-    ``A = [X 1] / scale`` (``scale`` the root mean square of each column, 1 for a zero column),
-    accumulated from ``X`` without forming ``[X 1]`` (one product ``X' X``)."""
-    n, nf = X.shape
-    sq = np.einsum("ij,ij->j", X, X)
-    scale = np.sqrt(sq / n) if n else np.ones(nf)
-    if constant:
-        scale = np.append(scale, 1.0)
+def _scaled(X: np.ndarray, constant: bool):
+    """``(A, scale)``: the regressors ``[X 1]`` divided by each column's root mean square (1 for a
+    zero column)."""
+    n = X.shape[0]
+    Phi = np.hstack([X, np.ones((n, 1))]) if constant else X
+    scale = np.sqrt(np.mean(Phi**2, axis=0)) if n else np.ones(Phi.shape[1])
     scale[scale == 0] = 1.0
-    XtX = X.T @ X
-    Xty = X.T @ y
-    if constant:
-        total = X.sum(axis=0)
-        G = np.empty((nf + 1, nf + 1))
-        G[:nf, :nf] = XtX
-        G[:nf, nf] = G[nf, :nf] = total
-        G[nf, nf] = n
-        b = np.append(Xty, y.sum())
-    else:
-        G, b = XtX, Xty
-    return G / np.outer(scale, scale), b / scale, scale
+    return Phi / scale, scale
 
 
 def _fit_region(X: np.ndarray, y: np.ndarray, constant: bool, ridge: float = 0.0):
     """``(theta, cond, G, scale)``: least squares of one region (:func:`solve_region`), with the
-    column-scaled normal matrix ``G`` (without the ridge; ``None`` when the SVD path was taken) that
-    :func:`parameter_covariance` would compute again."""
+    column-scaled normal matrix ``G = A' A`` that :func:`parameter_covariance` needs (``None``
+    when it was not formed: a ridge, or the SVD path), so that it is not formed twice."""
     n, nf = X.shape
-    p = nf + int(constant)
+    A, scale = _scaled(X, constant)
+    b = y
+    if ridge > 0:
+        pen = np.sqrt(ridge * max(n, 1)) * np.eye(A.shape[1])
+        if constant:
+            pen = pen[:-1]
+        A = np.vstack([A, pen])
+        b = np.concatenate([y, np.zeros(pen.shape[0])])
     coef = G = None
-    rows = n + (p - int(constant) if ridge > 0 else 0)
-    if rows >= 4 * p:  # tall: normal equations (fast), if well conditioned
-        G, b, scale = _normal_equations(X, y, constant)
-        M = G
-        if ridge > 0:  # the penalty rows sqrt(ridge n) I (offset free) add ridge n to the diagonal
-            M = G + ridge * max(n, 1) * np.diag(np.r_[np.ones(nf), np.zeros(int(constant))])
-        ev = np.linalg.eigvalsh(M)
+    if A.shape[0] >= 4 * A.shape[1]:  # tall: normal equations (fast), if well conditioned
+        G = A.T @ A
+        ev = np.linalg.eigvalsh(G)
         cond = float(np.sqrt(ev[-1] / ev[0])) if ev[0] > 0 else float("inf")
         if cond < 1e6:
-            coef = np.linalg.solve(M, b)
-        else:
-            G = None
+            coef = np.linalg.solve(G, A.T @ b)
     if coef is None:  # SVD least squares: robust to rank deficiency
-        Phi = np.hstack([X, np.ones((n, 1))]) if constant else X
-        scale = np.sqrt(np.mean(Phi**2, axis=0)) if n else np.ones(Phi.shape[1])
-        scale[scale == 0] = 1.0
-        A = Phi / scale
-        b = y
-        if ridge > 0:
-            pen = np.sqrt(ridge * max(n, 1)) * np.eye(A.shape[1])
-            if constant:
-                pen = pen[:-1]
-            A = np.vstack([A, pen])
-            b = np.concatenate([y, np.zeros(pen.shape[0])])
         coef, _, rank, sv = np.linalg.lstsq(A, b, rcond=None)
         cond = float(sv[0] / sv[-1]) if sv.size and sv[-1] > 0 else float("inf")
     coef = coef / scale
@@ -134,7 +110,7 @@ def _fit_region(X: np.ndarray, y: np.ndarray, constant: bool, ridge: float = 0.0
         theta[:] = coef
     else:
         theta[:nf] = coef
-    return theta, cond, G, scale
+    return theta, cond, (G if ridge == 0 else None), scale
 
 
 def solve_region(X: np.ndarray, y: np.ndarray, constant: bool, ridge: float = 0.0) -> tuple[np.ndarray, float]:
@@ -160,7 +136,8 @@ def parameter_covariance(X: np.ndarray, y: np.ndarray, theta: np.ndarray, consta
     r = y - X @ theta[:nf] - theta[nf]
     sigma2 = float(r @ r) / (n - p)
     if _normal is None or _normal[0] is None:
-        G, _, scale = _normal_equations(X, y, constant)
+        A, scale = _scaled(X, constant)
+        G = A.T @ A
     else:
         G, scale = _normal
     inv = np.linalg.pinv(G) / np.outer(scale, scale)
