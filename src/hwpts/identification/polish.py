@@ -17,9 +17,9 @@ it does not diverge; otherwise the least-squares parameters stay.
 from __future__ import annotations
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
 from hwpts.identification.simulation import free_run_sensitivity, simulate_pwarx
+from hwpts.identification.threads import single_threaded
 
 # Records up to this many simulated samples get a second local descent (Levenberg-Marquardt beside
 # the trust-region reflective one, from the same start; the lower cost kept). The simulation error
@@ -114,7 +114,7 @@ def polish_free_run(structure, partition, theta, kinds, inputs, output, center, 
             # one BLAS thread: the trust-region step's SVD of the (n x p) Jacobian (p tens) is fastest
             # single-threaded, and threaded BLAS beside another job spin-waits (measured 1.2 s -> 0.02 s
             # per SVD of 30,000 x 45 on a busy 2-core machine)
-            with threadpool_limits(limits=1, user_api="blas"):
+            with single_threaded("blas"):
                 res = least_squares(residuals, p0, jac=jacobian, method=method, x_scale="jac", max_nfev=nfev,
                                     ftol=FTOL)
         except (ValueError, np.linalg.LinAlgError) as error:  # pragma: no cover - defensive

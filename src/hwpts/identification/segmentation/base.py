@@ -6,9 +6,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from sklearn.base import BaseEstimator
-from threadpoolctl import threadpool_limits
 
 from hwpts.errors import ParameterError
+from hwpts.identification.threads import single_threaded
 
 
 @dataclass
@@ -137,6 +137,6 @@ def kmeans_labels(F: np.ndarray, n_clusters: int, rng, n_init: int = 10, sample_
     km = KMeans(n_clusters=n_clusters, n_init=n_init, random_state=int(rng.integers(2**31 - 1)))
     # one OpenMP thread: on a busy machine scikit-learn's threaded Lloyd iterations spin-wait for
     # cores and run 30x slower than a single thread on these sizes (measured, 4,000 x 11 rows)
-    with threadpool_limits(limits=1, user_api="openmp"):
+    with single_threaded("openmp"):
         km.fit(F[idx], sample_weight=w)
         return km.predict(F).astype(np.int64)

@@ -18,7 +18,6 @@ vectorised (batched normal equations), so the method scales to 10^5 samples.
 from __future__ import annotations
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
 from hwpts.identification.segmentation.base import (
     BoundedCache,
@@ -28,6 +27,7 @@ from hwpts.identification.segmentation.base import (
     kmeans_labels,
     standardize,
 )
+from hwpts.identification.threads import single_threaded
 
 
 _FEATURE_CACHE = BoundedCache(24)  # fingerprint of (X, y), n_neighbors -> local features (see local_features)
@@ -52,7 +52,7 @@ def _local_features(X, y, n_neighbors: int):
     n, nf = Z.shape
     p = nf + 1
     c = int(min(max(n_neighbors, p + 1), n))
-    with threadpool_limits(limits=1, user_api="openmp"):  # see base.kmeans_labels
+    with single_threaded("openmp"):  # see base.kmeans_labels
         idx = NearestNeighbors(n_neighbors=c).fit(Z).kneighbors(Z, return_distance=False)
     P = np.concatenate([Z[idx], np.ones((n, c, 1))], axis=2)  # (n, c, p)
     Y = ys[idx]

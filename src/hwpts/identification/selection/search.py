@@ -51,11 +51,11 @@ import warnings
 
 import numpy as np
 from sklearn.base import BaseEstimator, clone
-from threadpoolctl import threadpool_limits
 
 from hwpts.errors import HwptsError, IdentificationError, ParameterError
 from hwpts.identification.metrics import fit_percent
 from hwpts.identification.selection.splitters import BlockedSplit, breaks_of
+from hwpts.identification.threads import single_threaded
 
 __all__ = ["PWARXSearch", "expand_grid", "DEFAULT_METHODS", "ORDER_GRID"]
 
@@ -381,7 +381,7 @@ class PWARXSearch(BaseEstimator):
         # threaded BLAS on a busy machine spin-waits for cores (the polish's SVD of a 30,000 x 45
         # Jacobian took 1.2 s with two threads beside another job, 0.02 s with one); parallelism
         # belongs to the candidates (n_jobs), whose worker processes are single-threaded anyway
-        with threadpool_limits(limits=1):
+        with single_threaded():
             try:
                 if self.param_grid is not None:
                     candidates = expand_grid(self.param_grid)
