@@ -141,6 +141,13 @@ def test_search_grows_past_ten_regions_while_the_held_out_fit_keeps_rising():
     # an explicit max_regions is a hard limit
     capped = PWARXSearch(PWARX(0, 1, 0, random_state=0), methods=("threshold",), max_regions=6).fit(x, y)
     assert max(r["params"]["n_regions"] for r in capped.cv_results_) == 6
+    # past REGION_CAP a new best must gain GROWTH_GAIN x tolerance: with a tolerance of 40 points
+    # (8 points a count) the same map stops growing after two counts past the cap
+    from hwpts.identification.selection.search import GROWTH_GAIN
+
+    assert GROWTH_GAIN * 40 > 5
+    coarse = PWARXSearch(PWARX(0, 1, 0, random_state=0), methods=("threshold",), tolerance=40).fit(x, y)
+    assert max(r["params"]["n_regions"] for r in coarse.cv_results_) == REGION_CAP + 2
 
 
 def test_pwarx_is_one_model():

@@ -119,15 +119,19 @@ def solve_region(X: np.ndarray, y: np.ndarray, constant: bool, ridge: float = 0.
     return theta, cond
 
 
-def parameter_covariance(X: np.ndarray, y: np.ndarray, theta: np.ndarray, constant: bool,
-                         _normal=None) -> np.ndarray:
+def parameter_covariance(X: np.ndarray, y: np.ndarray, theta: np.ndarray, constant: bool) -> np.ndarray:
     """Covariance ``sigma^2 (Phi' Phi)^-1`` of one region's least-squares parameters (eq. 17).
 
     ``sigma^2 = RSS / (n - p)``, the residual variance with ``p`` parameters; the matrix is over
     ``[x' 1]`` (offset last; its row and column are zero without a constant term). ``nan`` when the
-    region has no more samples than parameters. (``_normal``: the ``(G, scale)`` least squares
-    already formed for these rows.)
+    region has no more samples than parameters.
     """
+    A, scale = _scaled(np.asarray(X, dtype=float), constant)
+    return _covariance(X, y, theta, constant, A.T @ A, scale)
+
+
+def _covariance(X, y, theta, constant, G, scale) -> np.ndarray:
+    """:func:`parameter_covariance` from the column-scaled normal matrix ``G`` already formed."""
     n, nf = X.shape
     cov = np.full((nf + 1, nf + 1), np.nan)
     p = nf + int(constant)
@@ -135,11 +139,6 @@ def parameter_covariance(X: np.ndarray, y: np.ndarray, theta: np.ndarray, consta
         return cov
     r = y - X @ theta[:nf] - theta[nf]
     sigma2 = float(r @ r) / (n - p)
-    if _normal is None or _normal[0] is None:
-        A, scale = _scaled(X, constant)
-        G = A.T @ A
-    else:
-        G, scale = _normal
     inv = np.linalg.pinv(G) / np.outer(scale, scale)
     if constant:
         cov[:] = sigma2 * inv
@@ -207,7 +206,10 @@ def fit_local_models(X: np.ndarray, y: np.ndarray, labels: np.ndarray, n_regions
             if sd > 0 and n_par < keep.sum() < keep.size:
                 Xi, yi = Xi[keep], yi[keep]
                 theta[i], cond[i], G, scale = _fit_region(Xi, yi, constant, ridge)
-        cov[i] = parameter_covariance(Xi, yi, theta[i], constant, _normal=(G, scale))
+        if G is None:  # a ridge or the SVD path: the plain normal matrix was not formed
+            A, scale = _scaled(Xi, constant)
+            G = A.T @ A
+        cov[i] = _covariance(Xi, yi, theta[i], constant, G, scale)
         if warn and counts[i] >= n_par and cond[i] > ILL_CONDITIONED:
             warnings.warn(
                 f"region {i + 1}: least squares is ill-conditioned (condition number {cond[i]:.3g}); "

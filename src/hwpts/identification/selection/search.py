@@ -24,8 +24,9 @@ Two ways to say what to try:
      free-run score nor the best held-out one-step fit (on a system whose free run is chaotic the
      free run alone cannot tell 3 regions from 6), or until every region would hold fewer than
      ``3 p`` rows; past 10 regions it goes on only while the held-out free-run fit itself keeps
-     setting new bests (``patience`` counts in a row without one stop it; at most 40 regions): a
-     smooth map approximated piece by piece asks for more pieces, a small one-step gain does not.
+     setting new bests by at least a fifth of ``tolerance`` (``patience`` counts in a row without
+     one stop it; at most 40 regions): a smooth map approximated piece by piece asks for more
+     pieces, a small one-step gain, or a free-run gain too small to change the choice, does not.
      Learned segmentations label at most 5,000 rows in these fits (``PWARX(max_rows=...)``).
      Candidates are raced over the blocks (Maron & Moore 1994; successive halving over the
      blocks): one whose running mean falls 10 points below the best so far, or, in the region
