@@ -130,7 +130,7 @@ def _block_costs(x, Phi, y, min_rows, n_grid):
     ok = (nodes[ib] - nodes[ia]) >= min_rows
     cost = np.full((m, m), np.inf)
     cost[ia[ok], ib[ok]] = _sse_many(C[ib[ok]] - C[ia[ok]], p, ridge)
-    return xs, nodes, cost, whole, gridded, order, ridge
+    return xs, nodes, cost, whole, gridded, order, ridge, C
 
 
 def optimal_split(x, Phi, y, n_regions, min_rows, n_grid=200, data_key=None, refine=True):
@@ -141,8 +141,8 @@ def optimal_split(x, Phi, y, n_regions, min_rows, n_grid=200, data_key=None, ref
     (on large data; the segmenter compares the columns by it and refines the winner's cuts).
     """
     Phi, y = np.asarray(Phi, dtype=float), np.asarray(y, dtype=float)
-    xs, nodes, cost, whole, gridded, order, ridge = _split_costs(np.asarray(x, dtype=float), Phi, y, min_rows,
-                                                                 n_grid, data_key)
+    xs, nodes, cost, whole, gridded, order, ridge, C = _split_costs(np.asarray(x, dtype=float), Phi, y, min_rows,
+                                                                    n_grid, data_key)
     if n_regions == 1:
         return whole, []
     m = nodes.size
@@ -164,22 +164,33 @@ def optimal_split(x, Phi, y, n_regions, min_rows, n_grid=200, data_key=None, ref
     cuts = cuts[::-1]
     sse = float(D[-1])
     if gridded and refine:  # the DP saw a grid: each cut moves to its exact best between the nodes around it
-        sse, cuts = _refine_cuts(xs, order, Phi, y, nodes, cuts, min_rows, ridge)
+        sse, cuts = _refine_cuts(xs, order, Phi, y, nodes, C, cuts, min_rows, ridge)
     return sse, [0.5 * (xs[k - 1] + xs[k]) for k in cuts]
 
 
-def _refine_cuts(xs, order, Phi, y, nodes, cuts, min_rows, ridge, rounds=3):
+def _refine_cuts(xs, order, Phi, y, nodes, C, cuts, min_rows, ridge, rounds=3):
     """``(sse, cuts)`` of a grid solution with each cut moved to the best exact position between
     the grid nodes around it, one cut at a time with its neighbours held (coordinate descent on
     the exact residual sum of squares, a few rounds). The exact cost of every position between two
-    nodes is one running sum of the rows there; the result is never worse than the grid's."""
+    nodes is one running sum of the rows there; the result is never worse than the grid's.
+    ``C``: the normal equations accumulated at the grid ``nodes`` (:func:`_block_costs`), so that
+    a block of rows costs the sums of its rows beyond the nearest nodes only (forming every block
+    from its rows took 0.3 s of a Silverbox search: 20,000 rows a block, 40 refinements)."""
     n = xs.size
     p = Phi.shape[1]
 
+    def rows(a, b):  # [Phi y] of the sorted rows [a, b)
+        idx = order[a:b]
+        return np.column_stack([Phi[idx], y[idx]])
+
     def gram(a, b):  # [Phi y]' [Phi y] over the sorted rows [a, b)
-        rows = order[a:b]
-        block = np.column_stack([Phi[rows], y[rows]])
-        return block.T @ block, block
+        i = int(np.searchsorted(nodes, a, side="left"))  # first node at or after a
+        j = int(np.searchsorted(nodes, b, side="right")) - 1  # last node at or before b
+        if i >= j:
+            block = rows(a, b)
+            return block.T @ block
+        head, tail = rows(a, int(nodes[i])), rows(int(nodes[j]), b)
+        return C[j] - C[i] + head.T @ head + tail.T @ tail
 
     cuts = [int(k) for k in cuts]
     pos = [int(np.searchsorted(nodes, k)) for k in cuts]  # each cut's grid node
@@ -192,9 +203,9 @@ def _refine_cuts(xs, order, Phi, y, nodes, cuts, min_rows, ridge, rounds=3):
             hi = min(int(nodes[min(pos[j] + 1, nodes.size - 1)]), b - min_rows)
             if hi <= lo:
                 continue
-            base, _ = gram(a, lo)
-            inner, window = gram(lo, hi)
-            total = base + inner + gram(hi, b)[0]
+            base = gram(a, lo)
+            window = rows(lo, hi)
+            total = base + window.T @ window + gram(hi, b)
             # the left block [a, c) for c = lo .. hi: base plus the window's rows before c
             left = np.concatenate([base[None], base + np.cumsum(window[:, :, None] * window[:, None, :], axis=0)])
             cand = np.arange(lo, hi + 1)
@@ -211,7 +222,7 @@ def _refine_cuts(xs, order, Phi, y, nodes, cuts, min_rows, ridge, rounds=3):
         if not moved:
             break
     edges = [0] + cuts + [n]
-    refined = float(sum(_sse_many(gram(a, b)[0][None], p, ridge)[0] for a, b in zip(edges[:-1], edges[1:])))
+    refined = float(sum(_sse_many(gram(a, b)[None], p, ridge)[0] for a, b in zip(edges[:-1], edges[1:])))
     return refined, cuts  # each move lowered the cost of its two blocks: refined <= the grid's sse
 
 
