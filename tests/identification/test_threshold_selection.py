@@ -174,6 +174,33 @@ def test_a_method_that_diverges_or_is_pruned_twice_stops_growing():
         assert search._still_racing(both, ["threshold", "alternating"], behind) == ["threshold", "alternating"]
 
 
+def test_runner_up_orders_race_only_the_methods_that_survived_the_best_order(monkeypatch):
+    """A method dropped from the race on the best ARX order is not raced on the runner-up orders
+    (the scores here are made up: threshold 90 %, alternating 70 % on every order and count)."""
+    from hwpts.identification.selection import search as S
+
+    tried = []
+
+    def scored(estimator, params, u, y, splits, prune_below=-np.inf, names=None, output_name=None, leader=None):
+        tried.append(params)
+        free, one = {"average": (50.0 - params["output_order"], 60.0), "threshold": (90.0, 99.0),
+                     "alternating": (70.0, 80.0)}[params["segmentation"]]
+        k = len(splits)
+        return {"params": params, "split_fits_percent": [free] * k, "mean_fit_percent": free, "diverged": False,
+                "pruned": False, "error": None, "n_regions_fitted": params["n_regions"], "fit_time_s": 0.0,
+                "mean_one_step_fit_percent": one, "split_one_step_fits_percent": [one] * k}
+
+    monkeypatch.setattr(S, "_evaluate", scored)
+    u, y = setar(600, 0)
+    search = PWARXSearch(PWARX(random_state=0), orders={"output_order": [1, 2], "input_order": [1],
+                                                        "input_delay": [1]}, n_orders=2, try_polish=False).fit(u, y)
+    methods = {na: [p["segmentation"] for p in tried if p["output_order"] == na and p["segmentation"] != "average"]
+               for na in (1, 2)}
+    assert methods[1] == ["threshold", "alternating"] * 2 + ["threshold"]  # dropped after trailing twice
+    assert methods[2] == ["threshold"] * 3  # never raced on the runner-up order
+    assert search.best_params_["segmentation"] == "threshold"
+
+
 def test_threshold_costs_are_reused_across_region_counts():
     from hwpts.identification.segmentation import threshold as th
 
