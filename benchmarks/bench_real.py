@@ -7,7 +7,12 @@ Scoring as each data set's README says: free-run simulation of the test record f
 measured samples; Silverbox and EMPS as RMSE (mV, mm), pick_and_place and the hydraulic actuator as
 fit %.
 
-``python -m benchmarks real [--sets=silverbox,emps,...] [--no-peers]``
+``python -m benchmarks real [--sets=silverbox,emps,...] [--no-peers] [--pyparc-fits=N] [--repeats=N]``
+
+The speed comparison on Silverbox: the default search timed ``--repeats`` times (3; it must choose
+the same model every time; the segmenters' caches emptied before each run, as in a new process) against ``--pyparc-fits`` PyPARC fits (5) with seeds 0, 1, ... (PyPARC's
+k-means start is random: unseeded, one fit took 3.9-15.8 s on the same data); the ratio is given
+against PyPARC's median fit and against its fastest, both to hwpts's median time.
 """
 
 from __future__ import annotations
@@ -76,33 +81,49 @@ def _free_run(model, u, y, n_init):
     return (np.full_like(y, np.nan) if sim.diverged else out), n0
 
 
-def _pyparc(py, u, y, tests, orders, n_init):
+def _pyparc_call(py, path, out, seed):
+    proc = subprocess.run([str(py), str(HERE / "peers" / "pyparc_freerun_runner.py"), str(path), "3", str(out),
+                           str(seed)], capture_output=True, text=True, timeout=7200)
+    if proc.returncode != 0:
+        raise RuntimeError(proc.stderr.strip().splitlines()[-1] if proc.stderr.strip() else "failed")
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+def _pyparc(py, u, y, tests, orders, n_init, n_fits):
+    """PyPARC fitted on the training data and simulated on each test record (seeds 0, 1, ...), then
+    fitted alone (timing only) until ``n_fits`` fits were timed: ``({test: (yhat, info)}, times)``."""
     results = {}
+    times = []
     na, nb, nk = orders
-    for name, (ut, yt) in tests.items():
-        with tempfile.TemporaryDirectory() as tmp:
-            path, out = Path(tmp) / "d.npz", Path(tmp) / "o.npz"
+    with tempfile.TemporaryDirectory() as tmp:
+        for seed, (name, (ut, yt)) in enumerate(tests.items()):
+            path, out = Path(tmp) / f"d{seed}.npz", Path(tmp) / f"o{seed}.npz"
             np.savez(path, u_train=u[:, 0], y_train=y, u_test=ut[:, 0], y_test=yt, na=na, nb=nb, nk=nk, n_init=n_init)
-            proc = subprocess.run([str(py), str(HERE / "peers" / "pyparc_freerun_runner.py"), str(path), "3", str(out)],
-                                  capture_output=True, text=True, timeout=7200)
-            if proc.returncode != 0:
-                raise RuntimeError(proc.stderr.strip().splitlines()[-1] if proc.stderr.strip() else "failed")
-            info = json.loads(proc.stdout.strip().splitlines()[-1])
+            info = _pyparc_call(py, path, out, seed)
             results[name] = (np.load(out)["yhat"], info)
-    return results
+            times.append(info["fit_time_s"])
+        for seed in range(len(tests), n_fits):
+            times.append(_pyparc_call(py, path, "-", seed)["fit_time_s"])
+    return results, times
 
 
 def main(argv=None) -> int:
     from hwpts.identification import PWARX, PWARXSearch
+    from hwpts.identification.segmentation import clear_caches
 
     argv = list(argv or [])
     if not DATA.exists():
         print(f"real-data benchmark skipped: {DATA} not found (set HWPTS_DATA_DIR)")
         return 0
     sets = list(SETS)
+    n_fits, repeats = 5, 3
     for a in argv:
         if a.startswith("--sets="):
             sets = a.split("=", 1)[1].split(",")
+        elif a.startswith("--pyparc-fits="):
+            n_fits = max(2, int(a.split("=", 1)[1]))
+        elif a.startswith("--repeats="):
+            repeats = max(1, int(a.split("=", 1)[1]))
     pyparc_py = None
     if "--no-peers" not in argv:
         from benchmarks.bench_identification import _pyparc_python
@@ -120,9 +141,16 @@ def main(argv=None) -> int:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             arx = PWARX(*cfg["arx"], n_regions=1, segmentation="average").fit(u, y)
-            t0 = time.perf_counter()
-            search = PWARXSearch(PWARX(random_state=0), orders="auto").fit(u, y)
-            elapsed = time.perf_counter() - t0
+            runs = []  # the speed target's record is timed `repeats` times: the median, same choice each time
+            for _ in range(repeats if name == "silverbox" and pyparc_py is not None else 1):
+                clear_caches()  # every run as a user's first: nothing reused from the run before
+                t0 = time.perf_counter()
+                search = PWARXSearch(PWARX(random_state=0), orders="auto").fit(u, y)
+                runs.append(time.perf_counter() - t0)
+                if len(runs) > 1 and search.best_params_ != first:
+                    raise RuntimeError(f"{name}: the default search chose {first}, then {search.best_params_}")
+                first = search.best_params_
+            elapsed = float(np.median(runs))
         model = search.best_estimator_
         st = model.structure_
         chosen = (f"na {st.na} nb {st.nb[0]} nk {st.nk[0]}, {model.segmentation_info_.get('method')}, "
@@ -139,7 +167,7 @@ def main(argv=None) -> int:
             status_lines.append((name, test, met))
         if name == "silverbox" and pyparc_py is not None:
             try:
-                res = _pyparc(pyparc_py, u, y, tests, cfg["arx"], n_init)
+                res, times = _pyparc(pyparc_py, u, y, tests, cfg["arx"], n_init, n_fits)
             except (RuntimeError, subprocess.SubprocessError) as error:
                 print(f"    PyPARC failed: {error}")
             else:
@@ -147,12 +175,11 @@ def main(argv=None) -> int:
                     score = _score(cfg, tests[test][1], yh, max(n_init, 3))
                     print(f"{'  PyPARC K=3':19s} {test:10s} {'':8s} {score:8.2f} {'':7s} {'':4s} {info['fit_time_s']:8.1f}"
                           f"  na 2 nb 3 nk 0 (its fit only; hwpts's time includes choosing orders, method, regions)")
-                # PyPARC fits the same training data once per test record: the ratio is taken
-                # against its fastest fit (the harder comparison for hwpts)
-                times = [info["fit_time_s"] for _, info in res.values()]
-                print(f"    speed: hwpts default {elapsed:.1f} s vs one PyPARC fit {min(times):.1f} s (fastest of "
-                      f"{len(times)}: {', '.join(f'{t:.1f}' for t in times)} s): {min(times) / elapsed:.2f}x "
-                      f"(target >= 3x)", flush=True)
+                median, fastest = float(np.median(times)), min(times)
+                print(f"    speed: hwpts default {elapsed:.1f} s (median of {len(runs)}: "
+                      f"{', '.join(f'{t:.1f}' for t in runs)} s) vs one PyPARC fit {median:.1f} s (median of "
+                      f"{len(times)} seeded fits: {', '.join(f'{t:.1f}' for t in times)} s): {median / elapsed:.2f}x; "
+                      f"against its fastest {fastest:.1f} s: {fastest / elapsed:.2f}x (target >= 3x)", flush=True)
     print("targets met: " + ", ".join(f"{n}/{t}: {'yes' if m else 'no'}" for n, t, m in status_lines))
     return 0
 

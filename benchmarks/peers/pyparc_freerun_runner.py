@@ -3,11 +3,14 @@
 Executed by ``benchmarks/bench_real.py`` with the interpreter of ``benchmarks/.venv-pyparc``.
 Usage::
 
-    python pyparc_freerun_runner.py DATA.npz K OUT.npz
+    python pyparc_freerun_runner.py DATA.npz K OUT.npz [SEED]
 
 DATA.npz holds u_train, y_train, u_test, y_test (one input) and orders na, nb, nk, n_init. The
 regressor is [y(k-1..k-na), u(k-nk..k-nk-nb+1)]; the free run builds it from its own outputs and
-starts from the first ``n_init`` measured outputs. OUT.npz receives the simulated output.
+starts from the first ``n_init`` measured outputs. OUT.npz receives the simulated output; OUT ``-``
+fits only (a timing run). SEED seeds numpy's global generator, which PyPARC's k-means start draws
+from (it passes no ``random_state``): unseeded, its fit time on Silverbox ranged 3.9-15.8 s between
+runs on the same data.
 """
 
 import json
@@ -27,6 +30,9 @@ def main(argv):
     path, K, out = argv[0], int(argv[1]), argv[2]
     from pyparc.parc import PARC
 
+    if len(argv) > 3:
+        np.random.seed(int(argv[3]))
+
     d = np.load(path)
     na, nb, nk, n_init = (int(d[k]) for k in ("na", "nb", "nk", "n_init"))
     X, y, m = regressors(d["u_train"], d["y_train"], na, nb, nk)
@@ -35,6 +41,9 @@ def main(argv):
     t0 = time.perf_counter()
     model.fit(X, y)
     fit_time = time.perf_counter() - t0
+    if out == "-":
+        print(json.dumps({"fit_time_s": fit_time}))
+        return 0
     u, yt = d["u_test"], d["y_test"]
     n0 = max(n_init, m)
     yhat = np.array(yt, dtype=float)

@@ -335,6 +335,18 @@ def test_the_cost_cache_is_bounded_by_bytes_too():
     assert cache._bytes == 0 and not cache
 
 
+def test_clear_caches_empties_every_segmenter_cache():
+    from hwpts.identification.segmentation import clear_caches
+    from hwpts.identification.segmentation import clustering, threshold as th
+
+    u, y = setar(800, 1)
+    PWARX(1, 1, 1, segmentation="threshold", n_regions=2).fit(u, y)
+    PWARX(1, 1, 1, segmentation="clustering", n_regions=2, random_state=0).fit(u, y)
+    assert len(th._COST_CACHE) > 0 and len(clustering._FEATURE_CACHE) > 0
+    clear_caches()
+    assert len(th._COST_CACHE) == 0 and th._COST_CACHE._bytes == 0 and len(clustering._FEATURE_CACHE) == 0
+
+
 def test_columns_screened_on_a_coarse_grid_keep_the_switching_column(monkeypatch):
     """On large data the columns are first scored on a coarse grid and only the best two on the
     full one: the switching column and its threshold are those of scoring every column fully."""

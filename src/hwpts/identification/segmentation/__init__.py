@@ -19,7 +19,7 @@ from __future__ import annotations
 from hwpts.errors import ParameterError
 from hwpts.identification.segmentation.alternating import AlternatingSegmenter
 from hwpts.identification.segmentation.average import AverageSegmenter
-from hwpts.identification.segmentation.base import SegmentationResult, Segmenter
+from hwpts.identification.segmentation.base import SegmentationResult, Segmenter, clear_caches
 from hwpts.identification.segmentation.clustering import ClusteringSegmenter
 from hwpts.identification.segmentation.hyperplane import HyperplaneSegmenter
 from hwpts.identification.segmentation.kmeans import KMeansSegmenter
@@ -36,7 +36,7 @@ SEGMENTATION_METHODS: dict[str, type[Segmenter]] = {
     "threshold": ThresholdSegmenter,
 }
 
-__all__ = ["SEGMENTATION_METHODS", "make_segmenter", "Segmenter", "SegmentationResult"]
+__all__ = ["SEGMENTATION_METHODS", "make_segmenter", "Segmenter", "SegmentationResult", "clear_caches"]
 
 
 def make_segmenter(name: str, **params) -> Segmenter:
