@@ -10,9 +10,10 @@ fit %.
 ``python -m benchmarks real [--sets=silverbox,emps,...] [--no-peers] [--pyparc-fits=N] [--repeats=N]``
 
 The speed comparison on Silverbox: the default search timed ``--repeats`` times (3; it must choose
-the same model every time; the segmenters' caches emptied before each run, as in a new process) against ``--pyparc-fits`` PyPARC fits (5) with seeds 0, 1, ... (PyPARC's
-k-means start is random: unseeded, one fit took 3.9-15.8 s on the same data); the ratio is given
-against PyPARC's median fit and against its fastest, both to hwpts's median time.
+the same model every time; the segmenters' caches emptied before each run, as in a new process)
+against ``--pyparc-fits`` PyPARC fits (5) with seeds 0, 1, ... (PyPARC's k-means start is random:
+unseeded, one fit took 3.9-15.8 s on the same data); the ratio is given against PyPARC's median
+fit and against its fastest, both to hwpts's median time.
 """
 
 from __future__ import annotations
