@@ -10,8 +10,9 @@ solved by ``scipy.optimize.least_squares`` (trust region; on short records Leven
 too, the lower cost kept, :data:`SECOND_SOLVER_ROWS`) starting from the least-squares parameters,
 with the Jacobian from the sensitivity recursion of the free run (compiled, one pass: a
 finite-difference Jacobian took one simulation per parameter, 1.2 s of Silverbox's 2.1 s of
-polish). The compiled simulator makes one evaluation cost microseconds per thousand samples. A polished model is kept only if its training free-run error is lower and
-it does not diverge; otherwise the least-squares parameters stay.
+polish). The compiled simulator makes one evaluation cost microseconds per thousand samples. A
+polished model is kept only if its training free-run error is lower and it does not diverge;
+otherwise the least-squares parameters stay.
 """
 
 from __future__ import annotations

@@ -90,7 +90,8 @@ _COST_CACHE = BoundedCache(1024, maxbytes=128 * 2**20)
 def _split_costs(x, Phi, y, min_rows, n_grid, data_key=None):
     """Sorted ``x``, the candidate block boundaries, the least-squares cost of every admissible
     block between two of them, the cost of all rows in one block, whether the boundaries are a
-    grid (fewer than the positions where ``x`` changes), the sorting order and the ridge. They do
+    grid (fewer than the positions where ``x`` changes), the sorting order, the ridge and the
+    normal equations accumulated at the boundaries (which :func:`_refine_cuts` reuses). They do
     not depend on the number of regions: a model search that grows the regions on the same rows
     reuses them (a small cache keyed by the data's hash;
     ``data_key``: a fingerprint of ``(Phi, y)`` already computed, with ``x`` a column of ``Phi``
