@@ -10,7 +10,11 @@ solved by ``scipy.optimize.least_squares`` (trust region; on short records Leven
 too, the lower cost kept, :data:`SECOND_SOLVER_ROWS`) starting from the least-squares parameters,
 with the Jacobian from the sensitivity recursion of the free run (compiled, one pass: a
 finite-difference Jacobian took one simulation per parameter, 1.2 s of Silverbox's 2.1 s of
-polish). The compiled simulator makes one evaluation cost microseconds per thousand samples. A
+polish). The solver sees the residuals and Jacobian compressed to one row more than there are
+parameters, with the same sum of squares, gradient and Gauss-Newton matrix, so its trust-region
+steps are the same and its SVD is of a 46 x 45 matrix rather than 20,000 x 45 (scipy's SVD of the
+full Jacobian was 19 ms of a step's 22 ms on Silverbox). The compiled simulator makes one
+evaluation cost microseconds per thousand samples. A
 polished model is kept only if its training free-run error is lower and it does not diverge;
 otherwise the least-squares parameters stay.
 """
@@ -36,12 +40,71 @@ SECOND_SOLVER_ROWS = 10_000
 # the last steps moved the training error by less than 1e-5 of itself, a fit change of 1e-4 points)
 FTOL = 1e-5
 
+# The polish's compression (:func:`compress`) goes through the Gauss-Newton matrix J'J when its
+# column-scaled eigenvalues span less than this (a scaled Jacobian's condition number below 1e5:
+# forming J'J loses about eps * cond^2 of the smallest eigenvalue, here at most 2e-6 of it), through
+# QR otherwise. Silverbox's polish Jacobians: 1.3e4; EMPS's: 4e12 and more (a column of zeros)
+GRAM_RCOND = 1e-10
+
 
 def _stretches(n: int, m: int, breaks) -> list[tuple[int, int]]:
     """``[start, stop)`` of the stretches between ``breaks`` long enough to simulate (more than
     ``m`` samples: the first ``m`` are the stretch's initial conditions)."""
     edges = [0] + sorted({int(b) for b in (breaks or ()) if 0 < int(b) < n}) + [n]
     return [(a, b) for a, b in zip(edges[:-1], edges[1:]) if b - a > m]
+
+
+def _scaled_gram(jac):
+    """Column norms ``D`` of ``J`` and the eigen-decomposition ``(W, V)`` of ``D^-1 J'J D^-1``."""
+    gram = jac.T @ jac
+    scale = np.sqrt(np.diag(gram))
+    scale[scale == 0] = 1.0
+    w, vec = np.linalg.eigh(gram / np.outer(scale, scale))
+    return scale, w, vec
+
+
+def gram_conditioned(jacobian) -> bool:
+    """Whether :func:`compress` takes the Gauss-Newton matrix's path for this Jacobian (its
+    column-scaled eigenvalues span less than :data:`GRAM_RCOND`, and it has no fewer rows than columns)."""
+    jac = np.asarray(jacobian, dtype=float)
+    if jac.shape[0] < jac.shape[1]:
+        return False
+    _, w, _ = _scaled_gram(jac)
+    return bool(w[0] > w[-1] * GRAM_RCOND)
+
+
+def compress(residuals, jacobian) -> tuple[np.ndarray, np.ndarray]:
+    """Residuals ``r`` (n) and Jacobian ``J`` (n x q, n >= q) compressed to ``q + 1`` rows with the
+    same sum of squares, gradient ``J'r`` and Gauss-Newton matrix ``J'J``.
+
+    A trust-region (or Levenberg-Marquardt) step depends on nothing else, so the solver takes the
+    same steps, while its SVD is of a (q + 1) x q matrix instead of the n x q Jacobian (Silverbox:
+    19 ms a step for 20,000 x 45, most of the polish). The compressed Jacobian is ``[C; 0]`` with
+    ``C'C = J'J``, the residuals ``[c; sqrt(r'r - c'c)]`` with ``C'c = J'r``:
+
+    - from the column-scaled ``J'J = D V W V' D`` (1.4 ms): ``C = W^1/2 V' D``,
+      ``c = W^-1/2 V' D^-1 J'r``, when its eigenvalues span less than :data:`GRAM_RCOND` (forming
+      ``J'J`` squares the condition number: past that its small eigenvalues lose their digits);
+    - otherwise from Householder QR, ``J = QR`` (13 ms, as accurate as the SVD): ``C = R``,
+      ``c = Q'r``.
+    """
+    r = np.asarray(residuals, dtype=float)
+    jac = np.asarray(jacobian, dtype=float)
+    q = jac.shape[1]
+    scale, w, vec = _scaled_gram(jac)
+    if jac.shape[0] >= q and w[0] > w[-1] * GRAM_RCOND:
+        root = np.sqrt(w)
+        top = (vec.T @ ((jac.T @ r) / scale)) / root
+        factor = (root[:, None] * vec.T) * scale
+    else:
+        from scipy.linalg import qr_multiply
+
+        if jac.shape[0] < q:  # fewer rows than parameters: pad (rows of zeros change nothing)
+            jac = np.vstack([jac, np.zeros((q - jac.shape[0], q))])
+            r = np.append(r, np.zeros(q - r.size))
+        top, factor = qr_multiply(jac, r, mode="right")
+    rest = max(float(r @ r) - float(top @ top), 0.0)
+    return np.append(top, np.sqrt(rest)), np.vstack([factor, np.zeros((1, q))])
 
 
 def polish_free_run(structure, partition, theta, kinds, inputs, output, center, bound,
@@ -92,13 +155,26 @@ def polish_free_run(structure, partition, theta, kinds, inputs, output, center, 
         return out - target
 
     columns = np.flatnonzero(mask.ravel())  # theta[mask] is theta's masked entries row by row
+    every = columns.size == mask.size  # every parameter free: the sensitivities need no selection
 
     def jacobian(p):
         """The sensitivity recursion (:func:`free_run_sensitivity`) of every stretch, stacked."""
         th = theta.copy()
         th[mask] = p
-        return np.concatenate([free_run_sensitivity(structure, th, u[a:b], sim)[m:, columns]
-                               for (a, b), sim in zip(parts, runs(th))])
+        blocks = [free_run_sensitivity(structure, th, u[a:b], sim)[m:] for (a, b), sim in zip(parts, runs(th))]
+        if not every:
+            blocks = [block[:, columns] for block in blocks]
+        return blocks[0] if len(blocks) == 1 else np.concatenate(blocks)
+
+    compact: dict = {}
+
+    def compressed(p):
+        """:func:`compress` of the residuals and Jacobian at ``p`` (both asked for at each point)."""
+        key = p.tobytes()
+        if compact.get("key") != key:
+            compact["r"], compact["J"] = compress(residuals(p), jacobian(p))
+            compact["key"] = key
+        return compact
 
     p0 = theta[mask]
     r0 = residuals(p0)
@@ -107,17 +183,28 @@ def polish_free_run(structure, partition, theta, kinds, inputs, output, center, 
     if p0.size == 0:
         return theta, info
     nfev = max_nfev or 30 * (p0.size + 1)
+    # the compressed problem (:func:`compress`) when the start's Gauss-Newton matrix keeps its digits
+    # (Silverbox); otherwise the full one, whose steps scipy takes from the Jacobian's SVD (EMPS,
+    # condition numbers of 1e12 and more: the compression would need a QR at every evaluation,
+    # rejected steps included, where scipy takes one SVD per accepted step)
+    with single_threaded("blas"):
+        small = gram_conditioned(jacobian(p0))
+    info["compressed"] = small
     # short records: a second descent (Levenberg-Marquardt) from the same start, the lower cost kept
     methods = ("trf", "lm") if target.size <= SECOND_SOLVER_ROWS else ("trf",)
     best = None
     for method in methods:
         try:
-            # one BLAS thread: the trust-region step's SVD of the (n x p) Jacobian (p tens) is fastest
+            # one BLAS thread: the Gauss-Newton matrix of the (n x p) Jacobian (p tens) is fastest
             # single-threaded, and threaded BLAS beside another job spin-waits (measured 1.2 s -> 0.02 s
             # per SVD of 30,000 x 45 on a busy 2-core machine)
             with single_threaded("blas"):
-                res = least_squares(residuals, p0, jac=jacobian, method=method, x_scale="jac", max_nfev=nfev,
-                                    ftol=FTOL)
+                if small:
+                    res = least_squares(lambda p: compressed(p)["r"], p0, jac=lambda p: compressed(p)["J"],
+                                        method=method, x_scale="jac", max_nfev=nfev, ftol=FTOL)
+                else:
+                    res = least_squares(residuals, p0, jac=jacobian, method=method, x_scale="jac",
+                                        max_nfev=nfev, ftol=FTOL)
         except (ValueError, np.linalg.LinAlgError) as error:  # pragma: no cover - defensive
             info["failed"] = str(error)
             continue
