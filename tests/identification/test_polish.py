@@ -60,3 +60,25 @@ def test_solver_takes_the_same_path_on_the_compressed_problem(method):
     np.testing.assert_allclose(small.x, full.x, rtol=1e-6)
     assert small.nfev == full.nfev
     assert small.cost == pytest.approx(full.cost, rel=1e-9)
+
+
+def test_gram_path_only_where_the_gauss_newton_matrix_keeps_its_digits():
+    """The compression forms J'J only for a well-conditioned Jacobian (scaled condition number below
+    about 1e5); otherwise (or with fewer rows than columns, or non-finite entries) it is not used."""
+    from hwpts.identification.polish import gram_conditioned
+
+    rng = np.random.default_rng(3)
+    jac = rng.standard_normal((300, 6)) * np.array([1.0, 1e3, 1e-3, 1.0, 10.0, 1.0])  # scaling alone
+    assert gram_conditioned(jac)
+    near = jac.copy()
+    near[:, 5] = near[:, 0] + 1e-7 * rng.standard_normal(300)  # two columns nearly equal: cond ~ 1e7
+    assert not gram_conditioned(near)
+    assert not gram_conditioned(jac[:4])
+    bad = jac.copy()
+    bad[0, 0] = np.nan
+    assert not gram_conditioned(bad)
+    # the QR path keeps the compression exact where the Gram path would lose the small direction
+    r = rng.standard_normal(300)
+    rc, jc = compress(r, near)
+    np.testing.assert_allclose(jc.T @ rc, near.T @ r, rtol=1e-8, atol=1e-8 * np.abs(near.T @ r).max())
+    np.testing.assert_allclose(rc @ rc, r @ r, rtol=1e-10)

@@ -67,7 +67,7 @@ def gram_conditioned(jacobian) -> bool:
     """Whether :func:`compress` takes the Gauss-Newton matrix's path for this Jacobian (its
     column-scaled eigenvalues span less than :data:`GRAM_RCOND`, and it has no fewer rows than columns)."""
     jac = np.asarray(jacobian, dtype=float)
-    if jac.shape[0] < jac.shape[1]:
+    if jac.shape[0] < jac.shape[1] or not np.all(np.isfinite(jac)):
         return False
     _, w, _ = _scaled_gram(jac)
     return bool(w[0] > w[-1] * GRAM_RCOND)
