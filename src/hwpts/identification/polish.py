@@ -10,10 +10,11 @@ solved by ``scipy.optimize.least_squares`` (trust region; on short records Leven
 too, the lower cost kept, :data:`SECOND_SOLVER_ROWS`) starting from the least-squares parameters,
 with the Jacobian from the sensitivity recursion of the free run (compiled, one pass: a
 finite-difference Jacobian took one simulation per parameter, 1.2 s of Silverbox's 2.1 s of
-polish). The solver sees the residuals and Jacobian compressed to one row more than there are
-parameters, with the same sum of squares, gradient and Gauss-Newton matrix, so its trust-region
-steps are the same and its SVD is of a 46 x 45 matrix rather than 20,000 x 45 (scipy's SVD of the
-full Jacobian was 19 ms of a step's 22 ms on Silverbox). The compiled simulator makes one
+polish). Where the start's Gauss-Newton matrix is well conditioned, the solver sees the residuals
+and Jacobian compressed to one row more than there are parameters, with the same sum of squares,
+gradient and Gauss-Newton matrix (:func:`compress`), so its trust-region steps are the same and
+its SVD is of a 46 x 45 matrix rather than 20,000 x 45 (scipy's SVD of the full Jacobian was 19 ms
+of a step's 22 ms on Silverbox). The compiled simulator makes one
 evaluation cost microseconds per thousand samples. A
 polished model is kept only if its training free-run error is lower and it does not diverge;
 otherwise the least-squares parameters stay.
