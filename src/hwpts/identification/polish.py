@@ -55,23 +55,23 @@ def _stretches(n: int, m: int, breaks) -> list[tuple[int, int]]:
     return [(a, b) for a, b in zip(edges[:-1], edges[1:]) if b - a > m]
 
 
-def _scaled_gram(jac):
-    """Column norms ``D`` of ``J`` and the eigen-decomposition ``(W, V)`` of ``D^-1 J'J D^-1``."""
+def _gram_path(jac):
+    """``(D, W, V)`` with ``D^-1 J'J D^-1 = V W V'`` (``D``: the column norms of ``J``) when the
+    Gauss-Newton matrix keeps its digits (finite, no fewer rows than columns, eigenvalues spanning
+    less than :data:`GRAM_RCOND`); ``None`` otherwise (the rule of :func:`compress`)."""
+    if jac.shape[0] < jac.shape[1] or not np.all(np.isfinite(jac)):
+        return None
     gram = jac.T @ jac
     scale = np.sqrt(np.diag(gram))
     scale[scale == 0] = 1.0
     w, vec = np.linalg.eigh(gram / np.outer(scale, scale))
-    return scale, w, vec
+    return (scale, w, vec) if w[0] > w[-1] * GRAM_RCOND else None
 
 
 def gram_conditioned(jacobian) -> bool:
     """Whether :func:`compress` takes the Gauss-Newton matrix's path for this Jacobian (its
     column-scaled eigenvalues span less than :data:`GRAM_RCOND`, and it has no fewer rows than columns)."""
-    jac = np.asarray(jacobian, dtype=float)
-    if jac.shape[0] < jac.shape[1] or not np.all(np.isfinite(jac)):
-        return False
-    _, w, _ = _scaled_gram(jac)
-    return bool(w[0] > w[-1] * GRAM_RCOND)
+    return _gram_path(np.asarray(jacobian, dtype=float)) is not None
 
 
 def compress(residuals, jacobian) -> tuple[np.ndarray, np.ndarray]:
@@ -92,8 +92,9 @@ def compress(residuals, jacobian) -> tuple[np.ndarray, np.ndarray]:
     r = np.asarray(residuals, dtype=float)
     jac = np.asarray(jacobian, dtype=float)
     q = jac.shape[1]
-    scale, w, vec = _scaled_gram(jac)
-    if jac.shape[0] >= q and w[0] > w[-1] * GRAM_RCOND:
+    gram = _gram_path(jac)
+    if gram is not None:
+        scale, w, vec = gram
         root = np.sqrt(w)
         top = (vec.T @ ((jac.T @ r) / scale)) / root
         factor = (root[:, None] * vec.T) * scale
@@ -159,13 +160,18 @@ def polish_free_run(structure, partition, theta, kinds, inputs, output, center, 
     every = columns.size == mask.size  # every parameter free: the sensitivities need no selection
 
     def jacobian(p):
-        """The sensitivity recursion (:func:`free_run_sensitivity`) of every stretch, stacked."""
-        th = theta.copy()
-        th[mask] = p
-        blocks = [free_run_sensitivity(structure, th, u[a:b], sim)[m:] for (a, b), sim in zip(parts, runs(th))]
-        if not every:
-            blocks = [block[:, columns] for block in blocks]
-        return blocks[0] if len(blocks) == 1 else np.concatenate(blocks)
+        """The sensitivity recursion (:func:`free_run_sensitivity`) of every stretch, stacked (the
+        last one kept: the start's is asked for by the path test and again by the solver)."""
+        key = p.tobytes()
+        if last.get("jac_key") != key:
+            th = theta.copy()
+            th[mask] = p
+            blocks = [free_run_sensitivity(structure, th, u[a:b], sim)[m:] for (a, b), sim in zip(parts, runs(th))]
+            if not every:
+                blocks = [block[:, columns] for block in blocks]
+            last["jac_key"] = key
+            last["jac"] = blocks[0] if len(blocks) == 1 else np.concatenate(blocks)
+        return last["jac"]
 
     compact: dict = {}
 
