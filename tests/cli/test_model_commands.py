@@ -221,6 +221,31 @@ def test_identify_chooses_the_orders_and_says_why(tmp_path, capsys):
     assert (choice["na"], choice["nb"], choice["nk"]) == (2, [2], [1])
     assert "held-out blocks" in choice["why"] and choice["n_candidates"] == len(summary["candidates"]) == 40
     assert sum(bool(r.get("chosen")) for r in summary["candidates"]) == 1
+    assert choice["scoring"] == "free-run" and "one-step" not in choice["why"]
+
+
+def test_identify_scoring(tmp_path, capsys):
+    """A chaotic two-mode map (the tent map): no ARX free run explains the data, so the one-step
+    fit ranks the candidates and the summary says so; --scoring free-run keeps the ARX model;
+    a bad --scoring is one line and exit 2."""
+    rng = np.random.default_rng(0)
+    u = rng.uniform(-1, 1, 1500)
+    y = np.zeros(1500)
+    for k in range(1, 1500):
+        y[k] = 1.0 - 1.8 * abs(y[k - 1]) + 0.1 * u[k - 1] + 0.01 * rng.standard_normal()
+    path = tmp_path / "tent.csv"
+    write_csv(path, {"u": u, "y": y})
+    out = tmp_path / "m.json"
+    base = ["identify", str(path), "--input", "u", "--output", "y", "--na", "1", "--nb", "1", "--out", str(out)]
+    assert main(base) == 0
+    choice = json.loads(capsys.readouterr().out)["choice"]
+    assert choice["scoring"] == "one-step" and choice["n_regions"] == 2
+    assert "ranked by the one-step fit because no ARX model's held-out free run reached 10 % fit" in choice["why"]
+    assert main(base + ["--scoring", "free-run"]) == 0
+    choice = json.loads(capsys.readouterr().out)["choice"]
+    assert choice["scoring"] == "free-run" and choice["n_regions"] == 1
+    out.unlink()
+    _expect_error(capsys, base + ["--scoring", "r2"], "--scoring", out)
 
 
 def test_search_bad_inputs_give_one_line(tmp_path, data_csv, capsys):

@@ -150,6 +150,55 @@ def test_search_grows_past_ten_regions_while_the_held_out_fit_keeps_rising():
     assert max(r["params"]["n_regions"] for r in coarse.cv_results_) == REGION_CAP + 2
 
 
+def _tent_map(n=1500, seed=0):
+    """y(k) = 1 - 1.8 |y(k-1)| + 0.1 u(k-1) + e: two affine modes switching on y(k-1) = 0; the
+    free run is chaotic (slope 1.8), so even the true model's free run loses the data."""
+    rng = np.random.default_rng(seed)
+    u = rng.uniform(-1, 1, n)
+    y = np.zeros(n)
+    for k in range(1, n):
+        y[k] = 1.0 - 1.8 * abs(y[k - 1]) + 0.1 * u[k - 1] + 0.01 * rng.standard_normal()
+    return u, y
+
+
+def test_search_ranks_by_one_step_fit_where_no_arx_free_run_explains_the_data():
+    """scoring="auto": the tent map's ARX free run fits under FREE_RUN_FLOOR (predicting the mean
+    does as well), so the one-step fit ranks the candidates and the two modes are found; ranked by
+    the free run, where the right model scores below the ARX one (-30 % or so), the search keeps
+    the ARX model."""
+    from hwpts.identification import PWARXSearch
+    from hwpts.identification.selection.search import FREE_RUN_FLOOR
+
+    u, y = _tent_map()
+    auto = PWARXSearch(PWARX(1, 1, 1, random_state=0)).fit(u, y)
+    arx = next(r for r in auto.cv_results_ if r["params"]["segmentation"] == "average")
+    assert arx["mean_fit_percent"] < FREE_RUN_FLOOR
+    assert auto.scoring_ == "one_step"
+    assert auto.best_estimator_.n_regions_ == 2
+    chosen = next(r for r in auto.cv_results_ if r.get("chosen"))
+    assert chosen["mean_one_step_fit_percent"] == auto.best_score_ > 95
+    # ranks follow the one-step means
+    done = sorted((r for r in auto.cv_results_ if r["mean_one_step_fit_percent"] is not None), key=lambda r: r["rank"])
+    means = [r["mean_one_step_fit_percent"] for r in done]
+    assert means == sorted(means, reverse=True)
+    v_u, v_y = _tent_map(seed=1)
+    assert fit_percent(v_y[1:], auto.predict(v_u, v_y)[1:]) > 95
+    free = PWARXSearch(PWARX(1, 1, 1, random_state=0), scoring="free_run").fit(u, y)
+    assert free.scoring_ == "free_run" and free.best_estimator_.n_regions_ == 1
+    # the ordinary case: an ARX model explains the free run, which then ranks the candidates
+    d = make_system(5, rng=1, n=1000)
+    assert PWARXSearch(PWARX(2, 2, 1, random_state=0), max_regions=3).fit(d.inputs, d.output).scoring_ == "free_run"
+
+
+def test_search_scoring_is_checked():
+    from hwpts.identification import PWARXSearch
+
+    u, y = _tent_map(200)
+    for bad in ("free-run", "r2", None, 1):
+        with pytest.raises(ParameterError, match="scoring must be one of"):
+            PWARXSearch(PWARX(1, 1, 1), scoring=bad).fit(u, y)
+
+
 def test_pwarx_is_one_model():
     """'auto' is not a segmentation: PWARX never selects among models."""
     d = make_system(5, rng=1, n=600)

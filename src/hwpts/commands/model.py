@@ -183,6 +183,7 @@ def _units(names, given) -> dict:
 
 def _fit_summary(model, data, path, out, elapsed, search=None):
     from hwpts.identification.metrics import fit_percent, rmse
+    from hwpts.identification.selection.search import FREE_RUN_FLOOR
 
     m = model.structure_.max_lag
     sim = model.simulate(data.inputs, data.output)
@@ -205,9 +206,13 @@ def _fit_summary(model, data, path, out, elapsed, search=None):
             "segmentation": summary["segmentation"], "n_regions": int(model.n_regions_),
             "polished": summary["polished"], "heldout_fit_percent": round(search.best_score_, 3),
             "n_candidates": len(table), "n_blocks": search.n_splits_,
-            "why": (f"best mean free-run fit over {search.n_splits_} held-out blocks of the training data "
+            "scoring": search.scoring_.replace("_", "-"),
+            "why": (f"best mean {'one-step' if search.scoring_ == 'one_step' else 'free-run'} fit over "
+                    f"{search.n_splits_} held-out blocks of the training data "
                     f"({len(table)} candidates; within {search.tolerance} points the fewest regions, then the "
-                    f"fewest parameters, win)"),
+                    f"fewest parameters, win)"
+                    + (f"; ranked by the one-step fit because no ARX model's held-out free run reached "
+                       f"{FREE_RUN_FLOOR:g} % fit" if search.scoring == "auto" and search.scoring_ == "one_step" else "")),
         }
         summary["candidates"] = table
     summary["fit_time_s"] = round(elapsed, 3)
@@ -352,6 +357,8 @@ def cmd_identify(args) -> int:
                 search.set_params(param_grid={**searched, "segmentation": [segmentation], "n_regions": [n_regions]})
         else:
             search = PWARXSearch(model, param_grid=dict(searched), progress=True, try_polish=False)
+    if search is not None:
+        search.set_params(scoring=args.scoring.replace("-", "_"))
     t0 = time.perf_counter()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -574,6 +581,10 @@ def register(subparsers):
     p.add_argument("--ridge", type=non_negative_float, default=0.0,
                    help="ridge penalty of the local least squares (relative to the regressors' scale; default 0)")
     p.add_argument("--polish", action="store_true", help="refine parameters on the free-run simulation error")
+    p.add_argument("--scoring", choices=["auto", "free-run", "one-step"], default="auto",
+                   help="what ranks the candidate models on the held-out blocks (default auto: the free-run "
+                        "fit, or the one-step fit when no ARX model's free run reaches 10 %% fit, as on a "
+                        "system whose free run is chaotic)")
     p.add_argument("--seed", type=non_negative_int, default=0, metavar="N", help="random seed (default 0)")
     p.add_argument("--unit", action="append", default=[], metavar="NAME=UNIT",
                    help="unit of a signal for plots and exports, e.g. y=mm (repeat; default: from the column "
