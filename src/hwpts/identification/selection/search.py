@@ -342,11 +342,11 @@ class PWARXSearch(BaseEstimator):
                                      f"{max_lag + 1} samples (the initial conditions)")
         return splits
 
-    def _run(self, base, candidates, u, y, splits, stage, bar, best=-np.inf, leader=None, race=True):
+    def _run(self, base, candidates, u, y, splits, stage, bar, best=-np.inf, leader=None, floor=-np.inf):
         """Rows of ``candidates``; in this process a candidate is raced against ``best`` (the best
-        mean so far) and, when a ``leader`` row is given, against the best complete row's blocks
-        (:func:`_trails`); in worker processes, or with ``race=False``, every candidate is scored
-        on every block."""
+        mean so far, once it reaches ``floor``) and, when a ``leader`` row is given, against the
+        best complete row's blocks (:func:`_trails`); in worker processes every candidate is
+        scored on every block."""
         from joblib import Parallel, delayed
 
         names, oname = self._names
@@ -354,9 +354,9 @@ class PWARXSearch(BaseEstimator):
         if self.n_jobs in (None, 1):
             rows = []
             for params in candidates:
-                rows.append(_evaluate(base, params, u, y, splits, best, names, oname, leader, one_step))
-                if race:
-                    best = max(best, self._score(rows[-1]))
+                rows.append(_evaluate(base, params, u, y, splits, best if best >= floor else -np.inf, names, oname,
+                                      leader, one_step))
+                best = max(best, self._score(rows[-1]))
                 if leader is not None and self._score(rows[-1]) > self._score(leader):
                     leader = rows[-1]
                 if bar is not None:
@@ -450,10 +450,10 @@ class PWARXSearch(BaseEstimator):
         table = []
         arx = {"segmentation": "average", "n_regions": 1, "segmentation_params": None}
         if len(order_grid) > 1:
-            # not raced when the scoring is still open: a free run 10 points behind says nothing
-            # when the one-step fit ends up ranking the orders
+            # with the scoring still open, raced on the free run only once some order's free run
+            # reaches FREE_RUN_FLOOR, which settles the scoring on the free run
             rows = self._run(base, [{**o, **arx} for o in order_grid], u, y, splits, "orders", bar,
-                             race=self.scoring == "free_run")
+                             floor=FREE_RUN_FLOOR if self.scoring == "auto" else -np.inf)
             table.extend(rows)
             self._decide_scoring(rows)
             ranked = sorted(rows, key=lambda r: -self._score(r))
