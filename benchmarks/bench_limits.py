@@ -16,7 +16,7 @@ Two questions the zoo and real-data benchmarks leave open, answered with numbers
    (orders and everything chosen on the training part) has its arrow error split between the
    samples near outputs beyond the training record's range and the rest.
 
-``python -m benchmarks limits [--seeds N] [--systems a,b] [--no-silverbox]``
+``python -m benchmarks limits [--seeds=N] [--systems=a,b] [--no-silverbox]``
 """
 
 from __future__ import annotations

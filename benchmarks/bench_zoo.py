@@ -21,7 +21,7 @@ an autoregressive part) is reported with its spread; region accuracy where modes
 matching of estimated to true regions). Systems without true parameters (function
 approximations) have no oracle row: PyPARC is their reference.
 
-``python -m benchmarks zoo [--seeds N] [--systems a,b] [--no-peers]``
+``python -m benchmarks zoo [--seeds=N] [--systems=a,b] [--no-peers]``
 """
 
 from __future__ import annotations

@@ -181,7 +181,8 @@ def test_runner_up_orders_race_only_the_methods_that_survived_the_best_order(mon
 
     tried = []
 
-    def scored(estimator, params, u, y, splits, prune_below=-np.inf, names=None, output_name=None, leader=None):
+    def scored(estimator, params, u, y, splits, prune_below=-np.inf, names=None, output_name=None, leader=None,
+               one_step=False):
         tried.append(params)
         free, one = {"average": (50.0 - params["output_order"], 60.0), "threshold": (90.0, 99.0),
                      "alternating": (70.0, 80.0)}[params["segmentation"]]
