@@ -21,7 +21,11 @@ an autoregressive part) is reported with its spread; region accuracy where modes
 matching of estimated to true regions). Systems without true parameters (function
 approximations) have no oracle row: PyPARC is their reference.
 
-``python -m benchmarks zoo [--seeds=N] [--systems=a,b] [--no-peers]``
+``--variants``: instead of the zoo's systems, its ``pwarx_random`` generator with other settings
+(:data:`VARIANTS`: other instances, orders, numbers of modes, partitions, noise, and modes sharing
+parameters), the systems the default was not tuned on.
+
+``python -m benchmarks zoo [--seeds=N] [--systems=a,b] [--variants] [--no-peers]``
 """
 
 from __future__ import annotations
@@ -41,6 +45,16 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 ZOO_PATH = Path(os.environ.get("HWPTS_ZOO", HERE.parent.parent / "shared" / "benchmarks" / "pwarx_zoo.py"))
 TARGET_GAP = 2.0  # points below the oracle's median one-step fit
+
+# --variants: pwarx_random's generator with settings other than the zoo's (label -> keyword arguments)
+VARIANTS = {
+    "rand_3m_n2000": {"n": 2000, "n_modes": 3},
+    "rand_4slabs": {"n": 5000, "n_modes": 4, "partition": "slabs"},
+    "rand_na3nb1_i3": {"n": 5000, "n_modes": 4, "na": 3, "nb": 1, "instance_seed": 3},
+    "rand_na1nb3_i5": {"n": 3000, "n_modes": 3, "na": 1, "nb": 3, "instance_seed": 5},
+    "rand_2m_noisy": {"n": 1000, "n_modes": 2, "sigma": 0.2, "instance_seed": 11},
+    "rand_6m_shared3": {"n": 20000, "n_modes": 6, "n_distinct": 3},
+}
 
 
 def load_zoo():
@@ -95,17 +109,21 @@ def one_step_fit(y, yhat):
     return 100.0 * (1.0 - np.linalg.norm(y - yhat) / np.linalg.norm(y - y.mean()))
 
 
-def run_system(zoo, name, seeds, pyparc_py, progress=None):
+def run_system(zoo, name, seeds, pyparc_py, progress=None, kw=None):
+    """Rows of every estimator on ``name``'s data sets; ``kw``: the generator's settings (default:
+    the zoo's, N = 20,000 for ``pwarx_random``)."""
     from hwpts.identification import region_accuracy
 
     gen, meta = zoo.SYSTEMS[name]
-    kw = {"n": 20000} if name == "pwarx_random" else {}
+    if kw is None:
+        kw = {"n": 20000} if name == "pwarx_random" else {}
+    same = {k: v for k, v in kw.items() if k not in ("n", "sigma")}  # the instance, validated noise-free
     rows = {k: {"onestep": [], "freerun": [], "regions": [], "time": [], "n_regions": []}
             for k in ("oracle", "modes", "arx", "hwpts", "pyparc")}
     notes = []
     for seed in seeds:
         d = gen(rng=seed, **kw)
-        v = gen(n=validation_n(d), sigma=0.0, rng=10_000 + seed, **({} if name != "hit_approx_sin" else {}))
+        v = gen(n=validation_n(d), sigma=0.0, rng=10_000 + seed, **same)
         if name == "hit_approx_sin":  # a fixed grid: validate on a 4x finer grid of the same interval
             v = gen(n=4 * 60, sigma=0.0)
         na, nb, nk, u = orders(d)
@@ -221,11 +239,16 @@ def main(argv=None) -> int:
         return 0
     n_seeds = 10
     systems = list(zoo.SYSTEMS)
+    runs = None  # (label, system, generator settings)
     for a in argv:
         if a.startswith("--seeds="):
             n_seeds = int(a.split("=", 1)[1])
         elif a.startswith("--systems="):
             systems = a.split("=", 1)[1].split(",")
+    if "--variants" in argv:
+        runs = [(label, "pwarx_random", kw) for label, kw in VARIANTS.items()]
+    else:
+        runs = [(name, name, None) for name in systems]
     pyparc_py = None
     if "--no-peers" not in argv:
         from benchmarks.bench_identification import _pyparc_python
@@ -234,7 +257,7 @@ def main(argv=None) -> int:
         if pyparc_py is None:
             print(f"PyPARC unavailable: {reason}; continuing without it", flush=True)
     seeds = list(range(n_seeds))
-    print(f"zoo: {len(systems)} systems x {n_seeds} seeds; one-step fit % on noise-free validation data "
+    print(f"zoo: {len(runs)} systems x {n_seeds} seeds; one-step fit % on noise-free validation data "
           f"(median over seeds); free run: median [10th percentile, max]", flush=True)
     header = (f"{'system':15s} {'oracle':>7s} {'modes':>6s} {'arx':>6s} {'hwpts':>6s} {'pyparc':>6s} {'gap':>6s} "
               f"{'regions':>7s} {'acc %':>6s} {'pp acc':>6s} {'hwpts s':>7s} {'pp s':>6s}  free run (hwpts | oracle)")
@@ -242,9 +265,9 @@ def main(argv=None) -> int:
     print("-" * len(header))
     failures = []
     summary = {}
-    for name in systems:
-        rows, notes = run_system(zoo, name, seeds, pyparc_py)
-        ref = zoo.REFERENCE.get(name, {})
+    for name, system, kw in runs:
+        rows, notes = run_system(zoo, system, seeds, pyparc_py, kw=kw)
+        ref = zoo.REFERENCE.get(system, {}) if kw is None else {"generator": system, **kw}
         oracle = _med(rows["oracle"]["onestep"])
         hw = _med(rows["hwpts"]["onestep"])
         pp = _med(rows["pyparc"]["onestep"])

@@ -194,30 +194,29 @@ def polish_free_run(structure, partition, theta, kinds, inputs, output, center, 
     # (Silverbox); otherwise the full one, whose steps scipy takes from the Jacobian's SVD (EMPS,
     # condition numbers of 1e12 and more: the compression would need a QR at every evaluation,
     # rejected steps included, where scipy takes one SVD per accepted step)
+    # one BLAS thread, entered once for the path test and the descents: the Gauss-Newton matrix of
+    # the (n x p) Jacobian (p tens) is fastest single-threaded, and threaded BLAS beside another job
+    # spin-waits (measured 1.2 s -> 0.02 s per SVD of 30,000 x 45 on a busy 2-core machine)
     with single_threaded("blas"):
         small = gram_conditioned(jacobian(p0))
-    info["compressed"] = small
-    # short records: a second descent (Levenberg-Marquardt) from the same start, the lower cost kept
-    methods = ("trf", "lm") if target.size <= SECOND_SOLVER_ROWS else ("trf",)
-    best = None
-    for method in methods:
-        try:
-            # one BLAS thread: the Gauss-Newton matrix of the (n x p) Jacobian (p tens) is fastest
-            # single-threaded, and threaded BLAS beside another job spin-waits (measured 1.2 s -> 0.02 s
-            # per SVD of 30,000 x 45 on a busy 2-core machine)
-            with single_threaded("blas"):
+        info["compressed"] = small
+        # short records: a second descent (Levenberg-Marquardt) from the same start, the lower cost kept
+        methods = ("trf", "lm") if target.size <= SECOND_SOLVER_ROWS else ("trf",)
+        best = None
+        for method in methods:
+            try:
                 if small:
                     res = least_squares(lambda p: compressed(p)["r"], p0, jac=lambda p: compressed(p)["J"],
                                         method=method, x_scale="jac", max_nfev=nfev, ftol=FTOL)
                 else:
                     res = least_squares(residuals, p0, jac=jacobian, method=method, x_scale="jac",
                                         max_nfev=nfev, ftol=FTOL)
-        except (ValueError, np.linalg.LinAlgError) as error:  # pragma: no cover - defensive
-            info["failed"] = str(error)
-            continue
-        if best is None or res.cost < best.cost:
-            best = res
-            info["method"] = method
+            except (ValueError, np.linalg.LinAlgError) as error:  # pragma: no cover - defensive
+                info["failed"] = str(error)
+                continue
+            if best is None or res.cost < best.cost:
+                best = res
+                info["method"] = method
     if best is None:  # pragma: no cover - defensive
         return theta, info
     res = best
