@@ -248,6 +248,32 @@ def test_identify_scoring(tmp_path, capsys):
     _expect_error(capsys, base + ["--scoring", "r2"], "--scoring", out)
 
 
+def test_identify_shared_modes(tmp_path, capsys):
+    """Two modes sharing their parameters over opposite quadrants: identify tries the switched
+    segmentation and says why (summary choice.shared_modes); --shared-modes off does not; a bad
+    value is one line and exit 2."""
+    rng = np.random.default_rng(0)
+    u = rng.uniform(-1, 1, (1500, 2))
+    y = np.where(u[:, 0] * u[:, 1] > 0, 1 + 2 * u[:, 0] - u[:, 1], -1 - u[:, 0] + 3 * u[:, 1])
+    y = y + 0.01 * rng.standard_normal(1500)
+    path = tmp_path / "xor.csv"
+    write_csv(path, {"u1": u[:, 0], "u2": u[:, 1], "y": y})
+    out = tmp_path / "m.json"
+    base = ["identify", str(path), "--input", "u1", "--input", "u2", "--output", "y", "--na", "0", "--nb", "1",
+            "--nk", "0", "--out", str(out)]
+    assert main(base) == 0
+    choice = json.loads(capsys.readouterr().out)["choice"]
+    assert choice["segmentation"] == "switched" and choice["n_regions"] >= 4
+    shared = choice["shared_modes"]
+    assert shared["tried"] and shared["gate_open"] and shared["from_modes"] == 2
+    assert shared["switched_in_sample_fits_percent"]["2"] > 98 > 70 > shared["best_heldout_one_step_fit_percent"]
+    assert main(base + ["--shared-modes", "off"]) == 0
+    choice = json.loads(capsys.readouterr().out)["choice"]
+    assert choice["segmentation"] != "switched" and choice["shared_modes"]["tried"] is False
+    out.unlink()
+    _expect_error(capsys, base + ["--shared-modes", "maybe"], "--shared-modes", out)
+
+
 def test_search_bad_inputs_give_one_line(tmp_path, data_csv, capsys):
     path = tmp_path / "short.csv"
     rng = np.random.default_rng(0)

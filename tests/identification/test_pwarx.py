@@ -199,6 +199,45 @@ def test_search_scoring_is_checked():
             PWARXSearch(PWARX(1, 1, 1), scoring=bad).fit(u, y)
 
 
+def test_search_tries_shared_modes_when_switched_models_fit_far_better():
+    """shared_modes="auto": on a map whose 2 modes share parameters over opposite quadrants, every
+    region candidate fits the held-out rows poorly while 2 switched models fit the training rows
+    almost exactly: the gate opens, ``switched`` is tried and wins; with shared_modes=False the
+    search keeps a region model that misses the modes. On an ordinary PWARX the gate stays shut."""
+    from hwpts.identification import PWARXSearch
+    from hwpts.identification.selection.search import MODES_GATE
+
+    rng = np.random.default_rng(0)
+    def shared(n, noise):
+        u = rng.uniform(-1, 1, (n, 2))
+        first = u[:, 0] * u[:, 1] > 0
+        return u, np.where(first, 1 + 2 * u[:, 0] - u[:, 1], -1 - u[:, 0] + 3 * u[:, 1]) + noise * rng.standard_normal(n)
+    u, y = shared(1500, 0.01)
+    uv, yv = shared(2000, 0.0)
+    auto = PWARXSearch(PWARX(0, 1, 0, random_state=0)).fit(u, y)
+    gate = auto.modes_gate_
+    assert gate["open"] and gate["modes"] == 2
+    assert 100 - gate["switched_fits_percent"][2] < MODES_GATE[0] * (100 - gate["best_one_step"])
+    assert auto.best_params_["segmentation"] == "switched" and auto.best_estimator_.n_regions_ >= 4
+    assert {r["stage"] for r in auto.cv_results_} >= {"regions", "modes"}
+    assert auto.score(uv, yv) > 90
+    off = PWARXSearch(PWARX(0, 1, 0, random_state=0), shared_modes=False).fit(u, y)
+    assert off.modes_gate_ is None and all(r["stage"] != "modes" for r in off.cv_results_)
+    assert off.score(uv, yv) < 70
+    d = make_system(5, rng=1, n=1000)
+    plain = PWARXSearch(PWARX(2, 2, 1, random_state=0), max_regions=3).fit(d.inputs, d.output)
+    assert plain.modes_gate_["open"] is False and all(r["stage"] != "modes" for r in plain.cv_results_)
+
+
+def test_search_shared_modes_is_checked():
+    from hwpts.identification import PWARXSearch
+
+    u, y = _tent_map(200)
+    for bad in ("yes", None, 1.5):
+        with pytest.raises(ParameterError, match="shared_modes must be True, False or 'auto'"):
+            PWARXSearch(PWARX(1, 1, 1), shared_modes=bad).fit(u, y)
+
+
 def test_pwarx_is_one_model():
     """'auto' is not a segmentation: PWARX never selects among models."""
     d = make_system(5, rng=1, n=600)

@@ -1,5 +1,7 @@
 """Segmentation methods: registry, the paper's methods, learned partitions on BENCHMARKS.md 1-3."""
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -19,7 +21,7 @@ from hwpts.identification.synthetic import make_system
 
 def test_registry_names_and_unknown_name_lists_them():
     assert set(SEGMENTATION_METHODS) == {"average", "zscore", "kmeans", "hyperplane", "clustering",
-                                         "alternating", "threshold"}
+                                         "alternating", "threshold", "switched"}
     with pytest.raises(ParameterError, match=r"unknown segmentation 'nope'; valid methods are \['alternating'"):
         make_segmenter("nope")
 
@@ -234,3 +236,56 @@ def test_learned_partition_predicts_by_its_scores_as_its_polyhedra():
         inside = v <= 0
         np.testing.assert_array_equal(fast, np.argmax(inside, axis=1))
         assert inside[np.arange(5000), fast].all()
+
+
+def _shared_modes_map(n, seed, noise=0.01):
+    """A static map whose two modes share their parameters over opposite quadrants (an XOR of the
+    signs of u1 and u2): no threshold on one input and no two compact regions separate them."""
+    rng = np.random.default_rng(seed)
+    u = rng.uniform(-1, 1, (n, 2))
+    first = u[:, 0] * u[:, 1] > 0
+    y = np.where(first, 1 + 2 * u[:, 0] - u[:, 1], -1 - u[:, 0] + 3 * u[:, 1]) + noise * rng.standard_normal(n)
+    return u, y, first
+
+
+def test_switched_finds_modes_shared_on_disjoint_regions():
+    """``switched``: the 2 modes first, then the regions each covers (here 2 quadrants each); the
+    alternating segmentation with 2 regions cannot separate them."""
+    from hwpts.identification.metrics import fit_percent
+
+    u, y, _ = _shared_modes_map(1500, 0)
+    uv, yv, first = _shared_modes_map(2000, 1, noise=0.0)
+    model = PWARX(0, 1, 0, n_regions=2, segmentation="switched", random_state=0).fit(u, y)
+    owners = model.segmentation_info_["mode_of_region"]
+    assert model.n_regions_ == len(owners) >= 4 and sorted(set(owners)) == [0, 1]
+    assert model.segmentation_info_["own_mode_share"][-1] > 0.97
+    assert fit_percent(yv, model.predict(uv, yv)) > 90
+    # the regions of one mode got (nearly) its parameters: the quadrants' models pair up
+    regions = model.predict_regions(uv, yv)
+    for r in range(model.n_regions_):
+        mine = first[regions == r]
+        assert mine.size == 0 or max(mine.mean(), 1 - mine.mean()) > 0.9
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the alternation may leave one region empty here
+        plain = PWARX(0, 1, 0, n_regions=2, segmentation="alternating", random_state=0).fit(u, y)
+    assert fit_percent(yv, plain.predict(uv, yv)) < 70
+    same = PWARX(0, 1, 0, n_regions=2, segmentation="switched", random_state=0).fit(u, y)
+    np.testing.assert_array_equal(same.theta_, model.theta_)
+
+
+def test_switched_fit_percent_is_the_in_sample_fit_of_the_best_switched_models():
+    from hwpts.identification.segmentation.switched import switched_fit_percent
+
+    u, y, _ = _shared_modes_map(1500, 0)
+    X = np.column_stack([u, np.zeros(len(y))])[:, :2]
+    two = switched_fit_percent(X, y, 2, np.random.default_rng(0))
+    one = switched_fit_percent(X, y, 1, np.random.default_rng(0))
+    assert two > 98 > 70 > one
+
+
+@pytest.mark.parametrize("bad", [{"n_restarts": 0}, {"max_regions": 0}, {"min_gain": -1.0},
+                                 {"screen_rows": 2.5}, {"confidence_margin": "x"}])
+def test_switched_parameters_are_checked(bad):
+    u, y, _ = _shared_modes_map(300, 0)
+    with pytest.raises(ParameterError, match="switched: " + next(iter(bad))):
+        PWARX(0, 1, 0, n_regions=2, segmentation="switched", segmentation_params=bad).fit(u, y)

@@ -207,6 +207,7 @@ def _fit_summary(model, data, path, out, elapsed, search=None):
             "polished": summary["polished"], "heldout_fit_percent": round(search.best_score_, 3),
             "n_candidates": len(table), "n_blocks": search.n_splits_,
             "scoring": search.scoring_.replace("_", "-"),
+            "shared_modes": _modes_gate_summary(search),
             "why": (f"best mean {'one-step' if search.scoring_ == 'one_step' else 'free-run'} fit over "
                     f"{search.n_splits_} held-out blocks of the training data "
                     f"({len(table)} candidates; within {search.tolerance} points the fewest regions, then the "
@@ -217,6 +218,19 @@ def _fit_summary(model, data, path, out, elapsed, search=None):
         summary["candidates"] = table
     summary["fit_time_s"] = round(elapsed, 3)
     return summary
+
+
+def _modes_gate_summary(search):
+    """The summary's account of the shared-modes stage: whether it ran and why."""
+    gate = getattr(search, "modes_gate_", None)
+    ran = any(r.get("stage") == "modes" for r in search.cv_results_)
+    if gate is None:
+        return {"tried": ran, "why": "not asked for" if search.shared_modes is False else "not reached"}
+    fits = {str(k): round(float(v), 3) for k, v in gate["switched_fits_percent"].items()}
+    best = gate["best_one_step"]
+    return {"tried": ran, "gate_open": bool(gate["open"]), "from_modes": gate["modes"],
+            "switched_in_sample_fits_percent": fits,
+            "best_heldout_one_step_fit_percent": round(float(best), 3) if np.isfinite(best) else None}
 
 
 def _orders_to_search(args):
@@ -358,7 +372,10 @@ def cmd_identify(args) -> int:
         else:
             search = PWARXSearch(model, param_grid=dict(searched), progress=True, try_polish=False)
     if search is not None:
-        search.set_params(scoring=args.scoring.replace("-", "_"))
+        shared = {"auto": "auto", "on": True, "off": False}[args.shared_modes]
+        if segmentation not in (None, "auto"):
+            shared = False  # the method is the user's: no other is tried
+        search.set_params(scoring=args.scoring.replace("-", "_"), shared_modes=shared)
     t0 = time.perf_counter()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -516,7 +533,8 @@ def _common_data_args(parser):
 
 # the registry's names, written out so that `hwpts --help` does not import the library (a test
 # checks that they match hwpts.identification.segmentation.SEGMENTATION_METHODS)
-SEGMENTATION_NAMES = ("alternating", "average", "clustering", "hyperplane", "kmeans", "threshold", "zscore")
+SEGMENTATION_NAMES = ("alternating", "average", "clustering", "hyperplane", "kmeans", "switched", "threshold",
+                      "zscore")
 
 
 def _mapping_args(parser):
@@ -585,6 +603,10 @@ def register(subparsers):
                    help="what ranks the candidate models on the held-out blocks (default auto: the free-run "
                         "fit, or the one-step fit when no ARX model's free run reaches 10 %% fit, as on a "
                         "system whose free run is chaotic)")
+    p.add_argument("--shared-modes", choices=["auto", "on", "off"], default="auto",
+                   help="also try the switched segmentation (the distinct local models first, then the regions "
+                        "each covers: equal parameters on disjoint regions); default auto: when some number of "
+                        "switched linear models fits the training data far better than every candidate's regions")
     p.add_argument("--seed", type=non_negative_int, default=0, metavar="N", help="random seed (default 0)")
     p.add_argument("--unit", action="append", default=[], metavar="NAME=UNIT",
                    help="unit of a signal for plots and exports, e.g. y=mm (repeat; default: from the column "

@@ -9,6 +9,8 @@ The registry's keys are the names the CLI accepts (``hwpts identify --segmentati
 - ``clustering``: Ferrari-Trecate et al. (2003) clustering of local parameter vectors;
 - ``alternating``: alternating assignment / least squares with a separability term (k-LinReg, PARC);
 - ``threshold``: thresholds on one regressor column, e.g. ``y(k-1)``, by least squares (SETAR/TARX);
+- ``switched``: ``n_regions`` distinct local models (switched regression), then the regions each covers
+  (modes that share parameters on disjoint regions);
 
 Choosing the method and the number of regions from the data is model selection, not segmentation:
 :class:`hwpts.identification.PWARXSearch` (``hwpts identify`` without ``--segmentation``).
@@ -23,6 +25,7 @@ from hwpts.identification.segmentation.base import SegmentationResult, Segmenter
 from hwpts.identification.segmentation.clustering import ClusteringSegmenter
 from hwpts.identification.segmentation.hyperplane import HyperplaneSegmenter
 from hwpts.identification.segmentation.kmeans import KMeansSegmenter
+from hwpts.identification.segmentation.switched import SwitchedSegmenter
 from hwpts.identification.segmentation.threshold import ThresholdSegmenter
 from hwpts.identification.segmentation.zscore import ZScoreSegmenter
 
@@ -34,6 +37,7 @@ SEGMENTATION_METHODS: dict[str, type[Segmenter]] = {
     "clustering": ClusteringSegmenter,
     "alternating": AlternatingSegmenter,
     "threshold": ThresholdSegmenter,
+    "switched": SwitchedSegmenter,
 }
 
 __all__ = ["SEGMENTATION_METHODS", "make_segmenter", "Segmenter", "SegmentationResult", "clear_caches"]

@@ -35,6 +35,12 @@ Two ways to say what to try:
      (``pruned``): it could not win. On Silverbox this cut the search from 16.6 s to 6.6 s with
      the same choice. A method dropped from the race on the best order (it trailed the leader of
      its region count ``patience`` counts in a row) is not raced on the runner-up orders;
+  2b. **shared modes** (``shared_modes``): when some number ``K`` of switched linear models (each
+     row predicted by the model that predicts it best) fits the training rows far better than the
+     best candidate's held-out one-step fit (:data:`MODES_GATE`), modes exist that the regions
+     tried miss (equal parameters on disjoint regions): the ``switched`` segmentation (``K``
+     modes, then the regions each covers) is tried on the leader's orders from that ``K`` up,
+     grown as the regions are;
   3. **choice**: the best score wins, but a candidate within ``tolerance`` points with fewer
      regions (then fewer parameters) is preferred: the simplest model the data support (the
      score: the mean held-out free-run fit, or the one-step fit where ``scoring`` says so, by
@@ -78,6 +84,14 @@ PRUNE_MARGIN = 10.0  # points below the best so far at which a candidate's remai
 # on the blocks, the growth stopped before the 4 true regions and the search kept the ARX model;
 # `python -m benchmarks zoo --variants`, rand_na3nb1_i3: median one-step fit 50.3 -> 95.8 %)
 FREE_RUN_FLOOR = 10.0
+# shared_modes="auto": the ``switched`` segmentation (modes first, then their regions) is tried when
+# some number of switched linear models fits the training rows (in sample) with under a quarter of
+# the one-step misfit of the best held-out candidate and 10 points more fit: modes exist that the
+# regions tried miss (equal parameters on disjoint regions). Measured: rand_6m_shared3 (3 modes on
+# 6 regions) 4.1 % misfit at 3 modes against the candidates' 55-64 %; in-sample switched fits
+# flatter the noise (rand_2m_noisy, sigma 0.2: 7 % misfit at 10 modes against the candidates'
+# 19-23 %, a ratio of 0.31-0.38, where the 2-region model is right), hence the quarter
+MODES_GATE = (0.25, 10.0)
 SCORINGS = ("auto", "free_run", "one_step")
 # "trailing" (:func:`_behind`): 2 points of free-run fit AND 20 % more one-step misfit (100 - fit)
 # than the leader. A candidate trailing the best complete candidate on the same first blocks is not
@@ -241,6 +255,10 @@ class PWARXSearch(BaseEstimator):
         Processes for the candidates (joblib); ``None`` runs them in this process.
     progress : bool
         A progress bar on a terminal.
+    shared_modes : {"auto", True, False}
+        Whether the adaptive search also tries the ``switched`` segmentation (module doc, step 2b):
+        ``"auto"`` (default) when the gate opens, ``True`` always, ``False`` never (nor when
+        ``"switched"`` is one of ``methods``, where it is grown as the others).
     scoring : {"auto", "free_run", "one_step"}
         What ranks the candidates: the mean held-out free-run fit, or the mean held-out one-step
         fit. ``"auto"`` (default): the free run, unless no single ARX model's held-out free run
@@ -259,6 +277,10 @@ class PWARXSearch(BaseEstimator):
         Its mean held-out fit % (free run or one-step, as ``scoring_`` says).
     scoring_ : str
         What ranked the candidates: ``"free_run"`` or ``"one_step"``.
+    modes_gate_ : dict or None
+        The shared-modes gate (``open``, the ``modes`` it opened at, the in-sample
+        ``switched_fits_percent`` by number of modes, the ``best_one_step`` held-out fit it was
+        compared with); ``None`` when the stage was not reached.
     cv_results_ : list of dict
         One row per candidate, in the order tried: ``params``, ``split_fits_percent``,
         ``mean_fit_percent`` (``None`` when diverged or failed), ``diverged``, ``error``,
@@ -283,7 +305,7 @@ class PWARXSearch(BaseEstimator):
     def __init__(self, estimator=None, param_grid=None, *, cv=None, methods=DEFAULT_METHODS, orders=None,
                  n_orders: int = 3, max_regions="auto", patience: int = 2, tolerance: float = 0.5,
                  try_polish="auto", refit_margin: float = 5.0, n_jobs=None, progress: bool = False,
-                 scoring: str = "auto"):
+                 scoring: str = "auto", shared_modes="auto"):
         self.estimator = estimator
         self.param_grid = param_grid
         self.cv = cv
@@ -298,6 +320,7 @@ class PWARXSearch(BaseEstimator):
         self.n_jobs = n_jobs
         self.progress = progress
         self.scoring = scoring
+        self.shared_modes = shared_modes
 
     # ------------------------------------------------------------------ helpers
     def _base(self):
@@ -413,6 +436,9 @@ class PWARXSearch(BaseEstimator):
             raise ParameterError(f"PWARXSearch: scoring must be one of {list(SCORINGS)}, got {self.scoring!r}")
         # "auto" is decided after the ARX stage of the adaptive search; until then the free run ranks
         self.scoring_ = "one_step" if self.scoring == "one_step" else "free_run"
+        if self.shared_modes not in (True, False, "auto"):
+            raise ParameterError(f"PWARXSearch: shared_modes must be True, False or 'auto', got {self.shared_modes!r}")
+        self.modes_gate_ = None
         order_grid = self._order_grid(base)
         max_lag = max(self._max_lag(base, o) for o in order_grid)
         splits = self._splits(n, max_lag)
@@ -539,7 +565,71 @@ class PWARXSearch(BaseEstimator):
                         break
             if number == 0:
                 survivors = active
+        table.extend(self._modes_stage(base, table, u, y, splits, bar))
         return table
+
+    def _modes_stage(self, base, table, u, y, splits, bar):
+        """Rows of the ``switched`` segmentation (modes first, then their regions) on the leader's
+        orders, when ``shared_modes`` says so: ``True`` always, ``"auto"`` when the gate opens
+        (:meth:`_modes_gate`). The number of modes grows from the gate's count while the score or
+        the one-step fit improves (``patience``), as in the region stage."""
+        if self.shared_modes is False or "switched" in tuple(self.methods):
+            return []
+        ok = [r for r in table if np.isfinite(self._score(r))]
+        if not ok:
+            return []
+        leader = max(ok, key=self._score)
+        orders = {k: leader["params"][k] for k in ORDER_KEYS if k in leader["params"]}
+        same = [r for r in ok if self._same_orders(r, orders)]
+        best = max(self._score(r) for r in same)
+        best_one = max((r["mean_one_step_fit_percent"] or -np.inf) for r in same)
+        p = self._n_params(base, orders, u.shape[1])
+        n_train = min(len(tr) for tr, _ in splits)
+        top = min(n_train // (3 * p), REGION_CAP if self.max_regions == "auto" else int(self.max_regions))
+        if top < 2:
+            return []
+        start = self._modes_gate(base, orders, u, y, best_one, top)
+        self.modes_gate_ = start
+        if start["open"] is False and self.shared_modes != True:  # noqa: E712 - True, not truthy
+            return []
+        rows_out, misses = [], 0
+        for k in range(int(start.get("modes") or 2), top + 1):
+            cand = [{**orders, "segmentation": "switched", "n_regions": k, "segmentation_params": None}]
+            lead = max(table + rows_out, key=self._score)
+            rows = self._run(base, cand, u, y, splits, "modes", bar, self._score(lead), lead)
+            rows_out.extend(rows)
+            stage_best = max(self._score(r) for r in rows)
+            stage_one = max((r["mean_one_step_fit_percent"] or -np.inf) for r in rows)
+            if stage_best > best or stage_one > best_one:
+                best, best_one, misses = max(best, stage_best), max(best_one, stage_one), 0
+            else:
+                misses += 1
+                if misses >= self.patience:
+                    break
+        return rows_out
+
+    def _modes_gate(self, base, orders, u, y, best_one, top) -> dict:
+        """Whether modes exist that the regions tried miss: the smallest number of switched
+        linear models (:func:`switched_fit_percent`, in sample, on all training rows) whose one-step
+        misfit is under :data:`MODES_GATE` [0] of the best held-out one-step misfit so far and whose fit
+        is :data:`MODES_GATE` [1] points above it."""
+        from hwpts.identification.regressors import RegressorStructure
+        from hwpts.identification.segmentation.switched import switched_fit_percent
+
+        na = orders.get("output_order", base.output_order)
+        nb = orders.get("input_order", base.input_order)
+        nk = orders.get("input_delay", base.input_delay)
+        structure = RegressorStructure.create(na, nb, nk, u.shape[1], base.constant)
+        X, t = structure.build(u, y)
+        seed = base.random_state if isinstance(base.random_state, (int, np.integer)) else 0
+        fits = {}
+        if best_one > 100.0 - MODES_GATE[1]:  # no fit can be MODES_GATE[1] points above it
+            return {"open": False, "modes": None, "switched_fits_percent": fits, "best_one_step": best_one}
+        for k in range(2, top + 1):
+            fits[k] = round(switched_fit_percent(X, t, k, np.random.default_rng(seed), n_restarts=3), 3)
+            if 100.0 - fits[k] < MODES_GATE[0] * (100.0 - best_one) and fits[k] > best_one + MODES_GATE[1]:
+                return {"open": True, "modes": k, "switched_fits_percent": fits, "best_one_step": best_one}
+        return {"open": False, "modes": None, "switched_fits_percent": fits, "best_one_step": best_one}
 
     def _decide_scoring(self, arx_rows):
         """``scoring="auto"``: the one-step fit ranks the candidates when no ARX model's held-out
