@@ -35,17 +35,17 @@ Two ways to say what to try:
      (``pruned``): it could not win. On Silverbox this cut the search from 16.6 s to 6.6 s with
      the same choice. A method dropped from the race on the best order (it trailed the leader of
      its region count ``patience`` counts in a row) is not raced on the runner-up orders;
-  2b. **shared modes** (``shared_modes``): when some number ``K`` of switched linear models (each
+  3. **shared modes** (``shared_modes``): when some number ``K`` of switched linear models (each
      row predicted by the model that predicts it best) fits the training rows far better than the
      best candidate's held-out one-step fit (:data:`MODES_GATE`), modes exist that the regions
      tried miss (equal parameters on disjoint regions): the ``switched`` segmentation (``K``
      modes, then the regions each covers) is tried on the leader's orders from that ``K`` up,
      grown as the regions are;
-  3. **choice**: the best score wins, but a candidate within ``tolerance`` points with fewer
+  4. **choice**: the best score wins, but a candidate within ``tolerance`` points with fewer
      regions (then fewer parameters) is preferred: the simplest model the data support (the
      score: the mean held-out free-run fit, or the one-step fit where ``scoring`` says so, by
      default where no ARX model's held-out free run reaches 10 % fit);
-  4. **polish** (``try_polish``): the winner is also scored with the simulation-error polish and
+  5. **polish** (``try_polish``): the winner is also scored with the simulation-error polish and
      polished if that gains more than ``tolerance``.
 
 Candidates of one stage are independent: a map over (parameters, split) pairs, run in processes
@@ -259,7 +259,7 @@ class PWARXSearch(BaseEstimator):
     progress : bool
         A progress bar on a terminal.
     shared_modes : {"auto", True, False}
-        Whether the adaptive search also tries the ``switched`` segmentation (module doc, step 2b):
+        Whether the adaptive search also tries the ``switched`` segmentation (module doc, step 3):
         ``"auto"`` (default) when the gate opens, ``True`` always, ``False`` never (nor when
         ``"switched"`` is one of ``methods``, where it is grown as the others).
     scoring : {"auto", "free_run", "one_step"}
@@ -560,11 +560,9 @@ class PWARXSearch(BaseEstimator):
                         misses += 1
                     if misses >= self.patience or (s == REGION_CAP and misses > 0):
                         break
-                elif stage_best > best or stage_one > best_one:
-                    best, best_one, misses = max(best, stage_best), max(best_one, stage_one), 0
                 else:
-                    misses += 1
-                    if misses >= self.patience:
+                    best, best_one, misses, stop = self._grow(best, best_one, stage_best, stage_one, misses)
+                    if stop:
                         break
             if number == 0:
                 survivors = active
@@ -593,7 +591,7 @@ class PWARXSearch(BaseEstimator):
             return []
         start = self._modes_gate(base, orders, u, y, best_one, top)
         self.modes_gate_ = start
-        if start["open"] is False and self.shared_modes != True:  # noqa: E712 - True, not truthy
+        if not start["open"] and self.shared_modes is not True:
             return []
         rows_out, misses = [], 0
         for k in range(int(start.get("modes") or 2), top + 1):
@@ -603,13 +601,18 @@ class PWARXSearch(BaseEstimator):
             rows_out.extend(rows)
             stage_best = max(self._score(r) for r in rows)
             stage_one = max((r["mean_one_step_fit_percent"] or -np.inf) for r in rows)
-            if stage_best > best or stage_one > best_one:
-                best, best_one, misses = max(best, stage_best), max(best_one, stage_one), 0
-            else:
-                misses += 1
-                if misses >= self.patience:
-                    break
+            best, best_one, misses, stop = self._grow(best, best_one, stage_best, stage_one, misses)
+            if stop:
+                break
         return rows_out
+
+    def _grow(self, best, best_one, stage_best, stage_one, misses):
+        """The growth rule of the region and modes stages: a count that improves the best score or
+        the best one-step fit resets the misses; ``patience`` misses in a row stop the growth.
+        Returns ``(best, best_one, misses, stop)``."""
+        if stage_best > best or stage_one > best_one:
+            return max(best, stage_best), max(best_one, stage_one), 0, False
+        return best, best_one, misses + 1, misses + 1 >= self.patience
 
     def _modes_gate(self, base, orders, u, y, best_one, top) -> dict:
         """Whether modes exist that the regions tried miss: the smallest number ``K`` of switched
