@@ -277,9 +277,8 @@ def test_switched_fit_percent_is_the_in_sample_fit_of_the_best_switched_models()
     from hwpts.identification.segmentation.switched import switched_fit_percent
 
     u, y, _ = _shared_modes_map(1500, 0)
-    X = np.column_stack([u, np.zeros(len(y))])[:, :2]
-    two = switched_fit_percent(X, y, 2, np.random.default_rng(0))
-    one = switched_fit_percent(X, y, 1, np.random.default_rng(0))
+    two = switched_fit_percent(u, y, 2, np.random.default_rng(0))
+    one = switched_fit_percent(u, y, 1, np.random.default_rng(0))
     assert two > 98 > 70 > one
 
 

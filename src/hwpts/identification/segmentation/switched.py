@@ -43,6 +43,26 @@ from hwpts.identification.segmentation.base import SegmentationResult, Segmenter
 EM_SETTLED = 0.002  # share of the rows whose move no longer counts: the hard EM has settled
 
 
+def switched_regression(Z, ys, K, rng, n_restarts=5, max_iter=20):
+    """``(labels, mean squared residual)`` of the best of ``n_restarts`` switched linear
+    regressions of ``ys`` on the standardised regressors ``Z`` with ``K`` models (the alternation
+    of :mod:`.alternating` without its separability term, at most ``max(50, 5 max_iter)`` steps)."""
+    n = Z.shape[0]
+    Phi = np.hstack([Z, np.ones((n, 1))])
+    best = None
+    for r in range(int(n_restarts)):
+        # the first start from k-means of [z, y], the others from random labels: k-means starts
+        # are alike (on one rand_6m_shared3 subset three of them ended in the same poor
+        # minimum, mean squared residual 0.070 against 0.0018; random labels reached 0.0018
+        # 11 times in 12)
+        init = (kmeans_labels(np.column_stack([Z, ys]), K, rng, n_init=1) if r == 0
+                else rng.integers(0, K, n).astype(np.int64))
+        labels, objective, _ = alternate(Phi, ys, Z, init, K, 0.0, max(50, 5 * int(max_iter)))
+        if best is None or objective < best[1]:
+            best = (labels, objective)
+    return best[0], float(best[1])
+
+
 def _hard_em(Z, regions, owner, mode, k, max_iter, init=None):
     """Region labels of the rows ``Z`` (each in a region of its own ``mode``; ``owner[r]`` is
     region ``r``'s mode) by hard EM: fit the classifier, move each row to its own mode's most
@@ -115,22 +135,11 @@ class SwitchedSegmenter(Segmenter):
                 raise ParameterError(f"switched: {name} must be a number >= 0, got {value!r}")
 
     def _modes(self, Z, ys, K, rng):
-        """Mode labels by switched linear regression (best of ``n_restarts`` starts) and the
-        rows each mode predicts clearly better than the others."""
+        """Mode labels by switched linear regression (:func:`switched_regression`) and the rows
+        each mode predicts clearly better than the others."""
         n = Z.shape[0]
+        mode, mse = switched_regression(Z, ys, K, rng, int(self.n_restarts), int(self.max_iter))
         Phi = np.hstack([Z, np.ones((n, 1))])
-        best = None
-        for r in range(int(self.n_restarts)):
-            # the first start from k-means of [z, y], the others from random labels: k-means starts
-            # are alike (on one rand_6m_shared3 subset three of them ended in the same poor
-            # minimum, mean squared residual 0.070 against 0.0018; random labels reached 0.0018
-            # 11 times in 12)
-            init = (kmeans_labels(np.column_stack([Z, ys]), K, rng, n_init=1) if r == 0
-                    else rng.integers(0, K, n).astype(np.int64))
-            labels, objective, _ = alternate(Phi, ys, Z, init, K, 0.0, max(50, 5 * int(self.max_iter)))
-            if best is None or objective < best[1]:
-                best = (labels, objective)
-        mode = best[0]
         theta = _fit_thetas(Phi, ys, mode, K, 1e-8)
         R = (ys[:, None] - Phi @ theta.T) ** 2
         sigma2 = float(np.median(R[np.arange(n), mode])) / 0.4549 + 1e-12
@@ -139,7 +148,7 @@ class SwitchedSegmenter(Segmenter):
         p = Z.shape[1] + 1
         if np.bincount(mode[confident], minlength=K).min() < p:
             confident[:] = True
-        return mode, confident, float(best[1])
+        return mode, confident, mse
 
     def _split(self, Z, regions, owner, mode, k, j, wrong_rows, rng, screen):
         """The best two-way split of region ``j`` (see the module doc): (labels, classifier, share)."""
@@ -233,5 +242,5 @@ def switched_fit_percent(X, y, n_modes: int, rng, n_restarts: int = 5) -> float:
         theta = _fit_thetas(Phi, ys, np.zeros(idx.size, dtype=np.int64), 1, 1e-8)
         mse = float(np.mean((ys - Phi @ theta[0]) ** 2))
     else:
-        _, _, mse = SwitchedSegmenter(n_restarts=n_restarts)._modes(Z, ys, int(n_modes), rng)
+        _, mse = switched_regression(Z, ys, int(n_modes), rng, n_restarts)
     return 100.0 * (1.0 - np.sqrt(max(mse, 0.0)))

@@ -475,10 +475,14 @@ class PWARXSearch(BaseEstimator):
         return self
 
     @staticmethod
-    def _max_lag(base, orders) -> int:
-        na = orders.get("output_order", base.output_order)
-        nb = orders.get("input_order", base.input_order)
-        nk = orders.get("input_delay", base.input_delay)
+    def _orders_of(base, orders) -> tuple:
+        """``(na, nb, nk)`` of a candidate: its own orders, else the estimator's."""
+        return (orders.get("output_order", base.output_order), orders.get("input_order", base.input_order),
+                orders.get("input_delay", base.input_delay))
+
+    @classmethod
+    def _max_lag(cls, base, orders) -> int:
+        na, nb, nk = cls._orders_of(base, orders)
         nbs = np.atleast_1d(nb)
         nks = np.atleast_1d(nk)
         return int(max([na] + [int(k) + int(b) - 1 for b, k in zip(np.broadcast_to(nbs, max(nbs.size, nks.size)),
@@ -624,15 +628,12 @@ class PWARXSearch(BaseEstimator):
         from hwpts.identification.regressors import RegressorStructure
         from hwpts.identification.segmentation.switched import switched_fit_percent
 
-        na = orders.get("output_order", base.output_order)
-        nb = orders.get("input_order", base.input_order)
-        nk = orders.get("input_delay", base.input_delay)
-        structure = RegressorStructure.create(na, nb, nk, u.shape[1], base.constant)
-        X, t = structure.build(u, y)
-        seed = base.random_state if isinstance(base.random_state, (int, np.integer)) else 0
         fits = {}
         if best_one > 100.0 - MODES_GATE[1]:  # no fit can be MODES_GATE[1] points above it
             return {"open": False, "modes": None, "switched_fits_percent": fits, "best_one_step": best_one}
+        structure = RegressorStructure.create(*self._orders_of(base, orders), u.shape[1], base.constant)
+        X, t = structure.build(u, y)
+        seed = base.random_state if isinstance(base.random_state, (int, np.integer)) else 0
         for k in range(1, top + 1):
             fits[k] = round(switched_fit_percent(X, t, k, np.random.default_rng(seed), n_restarts=3), 3)
             misfit = 100.0 - fits[k]
@@ -680,10 +681,10 @@ class PWARXSearch(BaseEstimator):
     def _same_orders(row, orders) -> bool:
         return all(row["params"].get(k) == v for k, v in orders.items())
 
-    @staticmethod
-    def _n_params(base, orders, n_inputs) -> int:
-        na = orders.get("output_order", base.output_order)
-        nb = np.broadcast_to(np.atleast_1d(orders.get("input_order", base.input_order)), (n_inputs,))
+    @classmethod
+    def _n_params(cls, base, orders, n_inputs) -> int:
+        na, nb, _ = cls._orders_of(base, orders)
+        nb = np.broadcast_to(np.atleast_1d(nb), (n_inputs,))
         return int(na + int(np.sum(nb)) + 1)
 
     def _rank(self, table):
