@@ -152,7 +152,13 @@ CASES = [
     (["identify", f"{W}/data.csv", *FIT, "--na", "2", "--nb", "2", "--regions", "0", "--out", f"{W}/m.json"], "--regions"),
     (["identify", f"{W}/data.csv", *FIT, "--na", "2", "--nb", "2", "--regions", "many", "--out", f"{W}/m.json"], "--regions"),
     (["identify", f"{W}/data.csv", *FIT, "--na", "2", "--nb", "2", "--segmentation", "kmeans", "--regions", "80",
-      "--out", f"{W}/m.json"], "n_regions=80"),
+      "--out", f"{W}/m.json"], "--regions 80: expected at most 18 for 400 samples"),
+    # more regions than the rows can hold (3 a parameter): refused, not a model with fewer regions
+    # (on 300 rows the search's smallest model once took --regions 50 and returned 2 regions)
+    (["identify", f"{W}/data.csv", *FIT, "--regions", "50", "--out", f"{W}/m.json"],
+     "--regions 50: expected at most 35 for the 320 training samples"),
+    (["identify", f"{W}/data.csv", *FIT, "--na", "1", "--nb", "1", "--segmentation", "alternating", "--regions", "50",
+      "--out", f"{W}/m.json"], "--regions 50: expected at most 33 for 400 samples"),
     (["identify", f"{W}/data.csv", *FIT, "--segmentation", "bogus", "--out", f"{W}/m.json"], "--segmentation"),
     (["identify", f"{W}/data.csv", *FIT, "--na", "2", "--nb", "2", "--hyperplane", "a,b,c", "--out", f"{W}/m.json"], "hyperplane"),
     (["identify", f"{W}/data.csv", *FIT, "--na", "2", "--nb", "2", "--segmentation", "hyperplane", "--out", f"{W}/m.json"], "--hyperplane"),
@@ -175,7 +181,7 @@ CASES = [
     (["identify", f"{W}/data.csv", *FIXED, "--regions", "4", "--out", f"{W}/m.json"], "--regions 4"),
     (["identify", f"{W}/data.csv", *FIT, "--segmentation", "zscore", "--regions", "3", "--out", f"{W}/m.json"], "--regions 3"),
     (["identify", f"{W}/data.csv", *FIT, "--na", "1", "--nb", "1", "--segmentation", "threshold", "--regions", "40",
-      "--out", f"{W}/m.json"], "at most 33 regions"),
+      "--out", f"{W}/m.json"], "--regions 40: expected at most 33 for 400 samples"),
     (["identify", f"{W}/constant_y.csv", *FIT, "--out", f"{W}/m.json"], "output 'y' is constant"),
     (["identify", f"{W}/data.csv", *FIXED, "--unit", "mm", "--out", f"{W}/m.json"], "--unit"),
     (["identify", f"{W}/data.csv", *FIXED, "--unit", "q=mm", "--out", f"{W}/m.json"], "--unit"),

@@ -285,7 +285,7 @@ def test_search_bad_inputs_give_one_line(tmp_path, data_csv, capsys):
     d = make_system(5, rng=0, n=300)
     write_csv(short, {"u1": d.inputs[:, 0], "u2": d.inputs[:, 1], "y": d.output})
     _expect_error(capsys, ["identify", str(short), *IDENTIFY, "--segmentation", "alternating", "--regions", "50",
-                           "--out", str(out)], "n_regions=50 is too many for 298 regressor rows", out)
+                           "--out", str(out)], "--regions 50: expected at most 14 for 300 samples", out)
 
 
 def test_regions_given_method_auto_chooses_among_the_default_methods(tmp_path, data_csv, capsys):

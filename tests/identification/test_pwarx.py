@@ -312,6 +312,24 @@ def test_refinement_that_empties_a_region_leaves_one_model():
     assert m.n_regions_ == 1 and m.partition_.n_regions == 1
 
 
+def test_search_passes_on_what_the_chosen_refit_says():
+    """The candidates' fits on the folds stay silent, but the chosen model's refit on all data
+    warns as a direct fit would: the same data, the regions merged, the RegionWarning reaches the
+    user (a model search once returned 3 regions for 40 asked, silently)."""
+    from hwpts.identification import PWARXSearch
+
+    x = np.random.default_rng(0).uniform(-1, 1, (800, 3))
+    y = np.where(x[:, 0] >= 0, x[:, 0] + 2.0, -x[:, 1] - 1.0)
+    est = PWARX(0, [1, 1, 1], [0, 0, 0], segmentation="alternating", random_state=0, partition_columns=["u3(k)"])
+    with pytest.warns(RegionWarning, match="dropped"):
+        search = PWARXSearch(est, param_grid={"n_regions": [2]}, try_polish=False).fit(x, y)
+    assert search.best_estimator_.n_regions_ == 1
+    with warnings.catch_warnings():  # the same search on data that need no warning: none
+        warnings.simplefilter("error", RegionWarning)
+        PWARXSearch(PWARX(0, [1, 1, 1], [0, 0, 0], segmentation="average", n_regions=1),
+                    param_grid={"n_regions": [1]}, try_polish=False).fit(x, y)
+
+
 def test_k_step_prediction_is_the_free_run_from_each_start():
     from hwpts.identification.simulation import simulate_pwarx
     from hwpts.identification.synthetic import make_system

@@ -252,6 +252,48 @@ def _orders_to_search(args):
     return fixed, searched
 
 
+# rows a region needs in a fit from ``--regions S``: 3 per parameter of its local model, the model
+# search's own limit when it grows the regions (fewer leave a local model barely determined, and a
+# learned segmentation then drops regions that received no row: `--regions 50` on 300 rows gave a
+# 2-region model and exit 0)
+ROWS_PER_PARAMETER = 3
+
+
+def _check_region_count(n_regions, n_samples, fixed, searched, n_inputs, searching) -> None:
+    """``--regions S`` leaves every region ``ROWS_PER_PARAMETER`` rows a parameter of the smallest
+    candidate model (the orders given, else the smallest of the search's grid), in the rows each
+    candidate is fitted on (``searching``: the training part of the search's cross-validation)."""
+    import itertools
+
+    from hwpts.identification.regressors import RegressorStructure
+    from hwpts.identification.selection import PWARXSearch
+
+    if not isinstance(n_regions, int) or n_regions < 2:
+        return
+    grid = [[fixed[k]] if k in fixed else list(searched.get(k, [])) for k in ("output_order", "input_order",
+                                                                             "input_delay")]
+    best = None
+    for na, nb, nk in itertools.product(*grid):
+        try:
+            st = RegressorStructure.create(na, nb, nk, n_inputs, True)
+        except ParameterError:
+            continue  # e.g. na = 0 with nb = 0: refused where the model is built, with its own message
+        rows = PWARXSearch().n_training_rows(n_samples, st.max_lag) if searching else n_samples
+        limit = (rows - st.max_lag) // (ROWS_PER_PARAMETER * st.n_parameters)
+        if best is None or limit > best[0]:
+            best = (limit, st)
+    if best is None:
+        return
+    limit, st = best
+    p = st.n_parameters
+    if n_regions > limit:
+        where = (f"the {PWARXSearch().n_training_rows(n_samples, st.max_lag)} training samples of each "
+                 f"cross-validation split of {n_samples}" if searching else f"{n_samples} samples")
+        raise ParameterError(
+            f"--regions {n_regions}: expected at most {max(limit, 1)} for {where} ({ROWS_PER_PARAMETER} rows a "
+            f"parameter, {p} parameters a region with {st.describe_orders()}), got {n_regions}")
+
+
 def _check_signals(inputs, output) -> None:
     """Each signal once, and the output not among the inputs (a model of y from y(k) is no model)."""
     seen = set()
@@ -328,6 +370,9 @@ def cmd_identify(args) -> int:
             raise ParameterError(f"--regions expects an int >= 1 or 'auto', got {regions!r}") from None
         if n_regions < 1:
             raise ParameterError(f"--regions expects an int >= 1, got {n_regions}")
+    if segmentation not in ("hyperplane", "average", "zscore"):
+        _check_region_count(n_regions, data.n_samples, fixed, searched, len(args.input),
+                            searching=bool(searched) or segmentation == "auto")
     region_models = None
     if args.zero_region:
         n_hyper = len(hyperplanes) + 1 if segmentation == "hyperplane" else n_regions
@@ -388,7 +433,7 @@ def cmd_identify(args) -> int:
                       sample_time=dt, units=units)
     elapsed = time.perf_counter() - t0
     summary = _fit_summary(model, data, args.data, args.out, elapsed, search)
-    notes = sorted({str(w.message) for w in caught if issubclass(w.category, UserWarning)})
+    notes = list(dict.fromkeys(str(w.message) for w in caught if issubclass(w.category, UserWarning)))
     if notes:
         summary["warnings"] = notes
     save_model(model, args.out)

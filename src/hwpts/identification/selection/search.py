@@ -348,6 +348,11 @@ class PWARXSearch(BaseEstimator):
                 raise ParameterError(f"PWARXSearch: orders[{key!r}] must be non-empty ints >= 0, got {values!r}")
         return expand_grid(grid)
 
+    def n_training_rows(self, n_samples: int, max_lag: int = 0) -> int:
+        """Samples of the smallest training part of this search's cross-validation on a record of
+        ``n_samples`` (what each candidate is fitted on), for orders whose largest lag is ``max_lag``."""
+        return int(min(len(train) for train, _ in self._splits(int(n_samples), int(max_lag))))
+
     def _splits(self, n: int, max_lag: int):
         min_block = MIN_BLOCK + max_lag
         cv = self.cv
@@ -707,21 +712,30 @@ class PWARXSearch(BaseEstimator):
         return near + rest
 
     def _refit(self, base, params, u, y, names, oname, splits, cv_mean):
+        """``(model, None, warnings)`` of the candidate refitted on all data, or ``(None, why, [])``;
+        ``warnings``: what the refit itself said about the model (:class:`RegionWarning`: regions
+        dropped, with too few rows, ill-conditioned), which the chosen model passes on to the user
+        (the candidates' fits on the folds stay silent)."""
+        from hwpts.identification.local_models import RegionWarning
+
         model = clone(base).set_params(**params)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", RegionWarning)
+            model.fit(u, y, names, oname)
+        said = [w for w in caught if issubclass(w.category, RegionWarning)]
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            model.fit(u, y, names, oname)
             fits = []
             for _, test in splits:
                 free, one = _block_fits(model, u, y, test)
                 if not np.isfinite(free):
-                    return None, "the refit on all data diverges in free run on a block"
+                    return None, "the refit on all data diverges in free run on a block", []
                 fits.append(one if self.scoring_ == "one_step" else free)
         if np.mean(fits) < cv_mean - self.refit_margin:
             kind = "one-step" if self.scoring_ == "one_step" else "block"
             return None, (f"refit on all data: {kind} fit {np.mean(fits):.1f} % is more than {self.refit_margin} "
-                          f"points below the cross-validated {cv_mean:.1f} %")
-        return model, None
+                          f"points below the cross-validated {cv_mean:.1f} %"), []
+        return model, None, said
 
     def _choose_and_refit(self, base, table, u, y, names, oname, splits):
         for row in self._preference(base, table, u):
@@ -736,12 +750,14 @@ class PWARXSearch(BaseEstimator):
                 if self._score(trial) > self._score(row) + self.tolerance:
                     params, row = trial["params"], trial
             try:
-                model, why = self._refit(base, params, u, y, names, oname, splits, self._score(row))
+                model, why, said = self._refit(base, params, u, y, names, oname, splits, self._score(row))
             except HwptsError as error:
-                model, why = None, f"refit on all data failed: {error}"
+                model, why, said = None, f"refit on all data failed: {error}", []
             if model is None:
                 row["error"] = why
                 continue
+            for w in said:
+                warnings.warn(str(w.message), w.category, stacklevel=3)
             row["chosen"] = True
             self._rank(table)
             self.best_params_ = params
