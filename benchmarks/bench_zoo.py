@@ -14,7 +14,8 @@ maps). Rows:
 - ``hwpts``: the library's default (:class:`hwpts.identification.PWARXSearch` on a ``PWARX`` with
   the system's orders; the number of regions and the method chosen on the training data only);
 - ``pyparc``: PyPARC 2.0 told the true number of regions (its own venv, as the identification
-  benchmark; skipped with the reason when it cannot be installed, or with ``--no-peers``).
+  benchmark; skipped with the reason when it cannot be installed, or with ``--no-peers``); its
+  k-means start seeded with the data set's seed, so two runs give the same column.
 
 One-step fit % (NRMSE) on the validation data is the headline; free-run fit (dynamic systems with
 an autoregressive part) is reported with its spread; region accuracy where modes exist (best
@@ -185,7 +186,7 @@ def run_system(zoo, name, seeds, pyparc_py, progress=None, kw=None):
         if pyparc_py is not None:
             Phi, Y, M = d.regressors()
             try:
-                out = _run_pyparc(pyparc_py, Phi, Y, Phi_v, d.n_modes)
+                out = _run_pyparc(pyparc_py, Phi, Y, Phi_v, d.n_modes, seed)
             except RuntimeError as error:
                 notes.append(f"pyparc seed {seed}: {error}")
             else:
@@ -199,11 +200,12 @@ def run_system(zoo, name, seeds, pyparc_py, progress=None, kw=None):
     return rows, notes
 
 
-def _run_pyparc(py, X, y, Xv, K):
+def _run_pyparc(py, X, y, Xv, K, seed):
     with tempfile.TemporaryDirectory() as tmp:
         path, out = Path(tmp) / "data.npz", Path(tmp) / "out.npz"
         np.savez(path, X_train=X, y_train=y, X_val=Xv)
-        proc = subprocess.run([str(py), str(HERE / "peers" / "pyparc_zoo_runner.py"), str(path), str(K), str(out)],
+        proc = subprocess.run([str(py), str(HERE / "peers" / "pyparc_zoo_runner.py"), str(path), str(K), str(out),
+                               str(seed)],
                               capture_output=True, text=True, timeout=3600)
         if proc.returncode != 0:
             raise RuntimeError(proc.stderr.strip().splitlines()[-1] if proc.stderr.strip() else "failed")

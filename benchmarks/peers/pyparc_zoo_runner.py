@@ -3,12 +3,14 @@
 Executed by ``benchmarks/bench_zoo.py`` with the interpreter of ``benchmarks/.venv-pyparc``.
 Usage::
 
-    python pyparc_zoo_runner.py DATA.npz K OUT.npz
+    python pyparc_zoo_runner.py DATA.npz K OUT.npz [SEED]
 
 DATA.npz holds X_train, y_train (training regressor rows and targets) and X_val (validation
 regressor rows built from measured outputs). OUT.npz receives ``yhat`` and ``regions`` for X_val;
 the fit time is printed as JSON. PyPARC is told the true number of regions ``K``; its other
 settings are those of its own examples (alpha 1e-4, sigma 1, softmax separation, 15 iterations).
+SEED seeds numpy's global generator, which PyPARC's k-means start draws from (it passes no
+``random_state``): unseeded, its column of the zoo table moved by up to 2 points between runs.
 """
 
 import json
@@ -22,6 +24,8 @@ def main(argv):
     path, K, out = argv[0], int(argv[1]), argv[2]
     from pyparc.parc import PARC
 
+    if len(argv) > 3:
+        np.random.seed(int(argv[3]))
     data = np.load(path)
     X, y, Xv = data["X_train"], data["y_train"], data["X_val"]
     model = PARC(K=K, alpha=1.0e-4, sigma=1.0, separation="Softmax", maxiter=15, cost_tol=1e-4,
