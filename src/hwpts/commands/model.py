@@ -281,14 +281,14 @@ def _check_region_count(n_regions, n_samples, fixed, searched, n_inputs, searchi
         rows = PWARXSearch().n_training_rows(n_samples, st.max_lag) if searching else n_samples
         limit = (rows - st.max_lag) // (ROWS_PER_PARAMETER * st.n_parameters)
         if best is None or limit > best[0]:
-            best = (limit, st)
+            best = (limit, st, rows)
     if best is None:
         return
-    limit, st = best
+    limit, st, rows = best
     p = st.n_parameters
     if n_regions > limit:
-        where = (f"the {PWARXSearch().n_training_rows(n_samples, st.max_lag)} training samples of each "
-                 f"cross-validation split of {n_samples}" if searching else f"{n_samples} samples")
+        where = (f"the {rows} training samples of each cross-validation split of {n_samples}" if searching
+                 else f"{n_samples} samples")
         raise ParameterError(
             f"--regions {n_regions}: expected at most {max(limit, 1)} for {where} ({ROWS_PER_PARAMETER} rows a "
             f"parameter, {p} parameters a region with {st.describe_orders()}), got {n_regions}")
