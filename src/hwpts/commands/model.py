@@ -252,21 +252,18 @@ def _orders_to_search(args):
     return fixed, searched
 
 
-# rows a region needs in a fit from ``--regions S``: 3 per parameter of its local model, the model
-# search's own limit when it grows the regions (fewer leave a local model barely determined, and a
-# learned segmentation then drops regions that received no row: `--regions 50` on 300 rows gave a
-# 2-region model and exit 0)
-ROWS_PER_PARAMETER = 3
-
-
 def _check_region_count(n_regions, n_samples, fixed, searched, n_inputs, searching) -> None:
     """``--regions S`` leaves every region ``ROWS_PER_PARAMETER`` rows a parameter of the smallest
     candidate model (the orders given, else the smallest of the search's grid), in the rows each
-    candidate is fitted on (``searching``: the training part of the search's cross-validation)."""
+    candidate is fitted on (``searching``: the training part of the search's cross-validation): the
+    model search's own limit when it grows the regions (fewer leave a local model barely
+    determined, and a learned segmentation then drops regions that received no row: `--regions 50`
+    on 300 rows gave a 2-region model and exit 0)."""
     import itertools
 
     from hwpts.identification.regressors import RegressorStructure
     from hwpts.identification.selection import PWARXSearch
+    from hwpts.identification.selection.search import ROWS_PER_PARAMETER
 
     if not isinstance(n_regions, int) or n_regions < 2:
         return

@@ -76,6 +76,7 @@ MIN_BLOCK = 10  # samples of a held-out block, beyond the initial conditions
 REGION_CAP = 10  # regions the adaptive search grows to by its usual rule (max_regions="auto") ...
 REGION_HARD_CAP = 40  # ... and at most beyond it, while each count sets a new best free-run fit
 GROWTH_GAIN = 0.2  # x tolerance: the least gain of a count past REGION_CAP that keeps the growth going
+ROWS_PER_PARAMETER = 3  # training rows a region needs per parameter of its local model (the growth's limit)
 PRUNE_MARGIN = 10.0  # points below the best so far at which a candidate's remaining blocks are skipped
 # scoring="auto": the held-out free-run fit ranks the candidates unless no single ARX model's free
 # run explains FREE_RUN_FLOOR % of the held-out output; then the one-step fit ranks them. Measured
@@ -520,16 +521,11 @@ class PWARXSearch(BaseEstimator):
         methods = tuple(self.methods)
         if not methods:
             raise ParameterError("PWARXSearch: methods leaves nothing to try")
-        n_train = min(len(tr) for tr, _ in splits)
         survivors = list(methods)
         for number, orders in enumerate(keep):
-            best = max([self._score(r) for r in table if self._same_orders(r, orders)], default=-np.inf)
-            best_one = max([r["mean_one_step_fit_percent"] or -np.inf for r in table if self._same_orders(r, orders)],
-                           default=-np.inf)
-            p = self._n_params(base, orders, u.shape[1])
-            top = min(n_train // (3 * p), REGION_HARD_CAP)
-            if self.max_regions != "auto":
-                top = min(n_train // (3 * p), int(self.max_regions))
+            best, best_one = self._bests(table, orders)
+            top = min(self._room(base, orders, u, splits),
+                      REGION_HARD_CAP if self.max_regions == "auto" else int(self.max_regions))
             misses = 0
             # the runner-up orders race only the methods that survived the best order's race: the
             # kept orders fit the data about as well as an ARX (on Silverbox within 0.02 points),
@@ -590,12 +586,9 @@ class PWARXSearch(BaseEstimator):
             return []
         leader = max(ok, key=self._score)
         orders = {k: leader["params"][k] for k in ORDER_KEYS if k in leader["params"]}
-        same = [r for r in ok if self._same_orders(r, orders)]
-        best = max(self._score(r) for r in same)
-        best_one = max((r["mean_one_step_fit_percent"] or -np.inf) for r in same)
-        p = self._n_params(base, orders, u.shape[1])
-        n_train = min(len(tr) for tr, _ in splits)
-        top = min(n_train // (3 * p), REGION_CAP if self.max_regions == "auto" else int(self.max_regions))
+        best, best_one = self._bests(table, orders)
+        top = min(self._room(base, orders, u, splits),
+                  REGION_CAP if self.max_regions == "auto" else int(self.max_regions))
         if top < 2:
             return []
         start = self._modes_gate(base, orders, u, y, best_one, top)
@@ -614,6 +607,18 @@ class PWARXSearch(BaseEstimator):
             if stop:
                 break
         return rows_out
+
+    def _room(self, base, orders, u, splits) -> int:
+        """Regions the smallest training part holds at :data:`ROWS_PER_PARAMETER` rows a parameter
+        of a local model with these orders."""
+        n_train = min(len(tr) for tr, _ in splits)
+        return n_train // (ROWS_PER_PARAMETER * self._n_params(base, orders, u.shape[1]))
+
+    def _bests(self, table, orders) -> tuple[float, float]:
+        """The best score and the best held-out one-step fit of the rows with these orders."""
+        same = [r for r in table if self._same_orders(r, orders)]
+        return (max((self._score(r) for r in same), default=-np.inf),
+                max((r["mean_one_step_fit_percent"] or -np.inf for r in same), default=-np.inf))
 
     def _grow(self, best, best_one, stage_best, stage_one, misses):
         """The growth rule of the region and modes stages: a count that improves the best score or
