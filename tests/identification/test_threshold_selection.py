@@ -4,6 +4,8 @@ import warnings
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from hwpts.errors import ParameterError
 from hwpts.identification import PWARX, PWARXSearch
@@ -268,6 +270,33 @@ def test_threshold_block_costs_are_the_least_squares_residuals(n):
         residual = y[rows] - Phi[rows] @ np.linalg.lstsq(Phi[rows], y[rows], rcond=None)[0]
         assert cost[i, j] == pytest.approx(residual @ residual, rel=1e-5)  # (a 1e-10 ridge)
     assert whole == pytest.approx(cost[0, nodes.size - 1], rel=1e-12)
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), p=st.integers(1, 8), rows=st.integers(1, 40),
+       collinear=st.booleans())
+def test_block_costs_kernel_is_least_squares_residuals(seed, p, rows, collinear):
+    """The compiled block cost (the last Cholesky pivot of the augmented Gram matrix) is the
+    residual sum of squares of least squares, also on blocks whose Gram matrix is singular (fewer
+    rows than parameters, or a repeated column: the pseudo-inverse fallback), by pairs of running
+    sums as by stacked matrices."""
+    from hwpts.identification.segmentation import threshold as th
+
+    rng = np.random.default_rng(seed)
+    blocks = [rng.standard_normal((rows + k, p + 1)) for k in range(3)]
+    if collinear and p > 1:
+        blocks[1][:, 1] = blocks[1][:, 0]
+    S = np.stack([b.T @ b for b in blocks])
+    expected = []
+    for b in blocks:
+        A, t = b[:, :p], b[:, p]
+        r = t - A @ np.linalg.lstsq(A, t, rcond=None)[0]
+        expected.append(r @ r)
+    scale = max(1.0, float(np.max(np.abs(S))))
+    assert th._sse_many(S, p, 0.0) == pytest.approx(expected, abs=1e-8 * scale)
+    C = np.concatenate([np.zeros((1, p + 1, p + 1)), np.cumsum(S, axis=0)])
+    pairs = th._sse_pairs(C, np.arange(3), np.arange(1, 4), p, 0.0)
+    assert pairs == pytest.approx(expected, abs=1e-8 * scale)
 
 
 def test_a_grid_of_cuts_is_refined_to_the_exact_thresholds():

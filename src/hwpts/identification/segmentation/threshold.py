@@ -28,6 +28,7 @@ signal) it is the least-squares estimate of the switching points, which no clust
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 
 from hwpts.errors import IdentificationError, ParameterError
@@ -103,7 +104,10 @@ def _split_costs(x, Phi, y, min_rows, n_grid, data_key=None):
 def _block_costs(x, Phi, y, min_rows, n_grid):
     """What :func:`_split_costs` returns, computed."""
     n, p = Phi.shape
-    order = np.argsort(x, kind="stable")
+    # blocks end only where x changes, so the order within ties moves nothing but the summation
+    # order: numpy's quicksort (vectorised) sorted Silverbox's 20,000 rows in 0.17 ms, a stable
+    # sort in 1.2 ms (60 sorts a search)
+    order = np.argsort(x)
     xs = x[order]
     changes = np.flatnonzero(xs[1:] > xs[:-1]) + 1  # a cut at k splits rows [0, k) | [k, n)
     changes = changes[(changes >= min_rows) & (changes <= n - min_rows)]
@@ -126,11 +130,11 @@ def _block_costs(x, Phi, y, min_rows, n_grid):
     else:  # few rows between boundaries (small data): running sums over the rows
         C = np.concatenate([np.zeros((1, p + 1, p + 1)), np.cumsum(Pw[:, :, None] * Pw[:, None, :], axis=0)])[nodes]
     ridge = 1e-10 * float(np.trace(C[-1, :p, :p])) / p
-    whole = float(_sse_many(C[-1:] - C[:1], p, ridge)[0])
+    whole = float(_sse_pairs(C, np.array([0]), np.array([m - 1]), p, ridge)[0])
     ia, ib = np.triu_indices(m, k=1)
     ok = (nodes[ib] - nodes[ia]) >= min_rows
     cost = np.full((m, m), np.inf)
-    cost[ia[ok], ib[ok]] = _sse_many(C[ib[ok]] - C[ia[ok]], p, ridge)
+    cost[ia[ok], ib[ok]] = _sse_pairs(C, ia[ok], ib[ok], p, ridge)
     return xs, nodes, cost, whole, gridded, order, ridge, C
 
 
@@ -230,15 +234,66 @@ def _refine_cuts(xs, order, Phi, y, nodes, C, cuts, min_rows, ridge, rounds=3):
 def _sse_many(S, p, ridge):
     """Residual sums of squares of least squares from stacked augmented Gram matrices
     ``S = [Phi y]' [Phi y]`` (k, p + 1, p + 1) of blocks of rows (a ``ridge`` on the diagonal)."""
+    S = np.ascontiguousarray(S, dtype=float)
     if S.shape[0] == 0:
         return np.zeros(0)
-    G = S[:, :p, :p] + ridge * np.eye(p)
-    r = S[:, :p, p]
-    try:
-        theta = np.linalg.solve(G, r[..., None])[..., 0]
-    except np.linalg.LinAlgError:
+    return _sse_pairs(S, None, None, p, ridge)
+
+
+def _sse_pairs(C, ia, ib, p, ridge):
+    """:func:`_sse_many` of the blocks ``C[ib] - C[ia]`` (``C``: running Gram matrices; ``ia``
+    ``None``: of ``C`` itself), without stacking the differences: each residual sum of squares is
+    the last pivot of the Cholesky factorisation of its augmented Gram matrix (compiled; the
+    stacked differences and numpy's batched LU solve took 14 ms a table of 200 cuts at p = 9,
+    this 2.6 ms). A block whose Gram matrix is not positive definite is solved by least squares
+    (pseudo-inverse) instead."""
+    pairs = ia is not None
+    if not pairs:
+        ia = ib = np.zeros(0, dtype=np.int64)
+    ia = np.ascontiguousarray(ia, dtype=np.int64)
+    ib = np.ascontiguousarray(ib, dtype=np.int64)
+    out = _cholesky_sse(np.ascontiguousarray(C, dtype=float), ia, ib, pairs, int(p), float(ridge))
+    bad = np.flatnonzero(np.isnan(out))
+    if bad.size:
+        S = C[ib[bad]] - C[ia[bad]] if pairs else C[bad]
+        G = S[:, :p, :p] + ridge * np.eye(p)
+        r = S[:, :p, p]
         theta = np.einsum("nij,nj->ni", np.linalg.pinv(G), r)
-    return np.maximum(S[:, p, p] - np.einsum("ni,ni->n", r, theta), 0.0)
+        out[bad] = np.maximum(S[:, p, p] - np.einsum("ni,ni->n", r, theta), 0.0)
+    return out
+
+
+@numba.njit(cache=True, nogil=True)
+def _cholesky_sse(C, ia, ib, pairs, p, ridge):
+    """The kernel of :func:`_sse_pairs`: NaN where a pivot of the first ``p`` is not positive."""
+    k = ia.size if pairs else C.shape[0]
+    q = p + 1
+    out = np.empty(k)
+    A = np.empty((q, q))
+    for t in range(k):
+        for i in range(q):
+            for j in range(i + 1):
+                A[i, j] = C[ib[t], i, j] - C[ia[t], i, j] if pairs else C[t, i, j]
+        for i in range(p):
+            A[i, i] += ridge
+        out[t] = np.nan
+        for j in range(q):
+            s = A[j, j]
+            for l in range(j):
+                s -= A[j, l] * A[j, l]
+            if j == p:  # the Schur complement of the Gram matrix: y'y - r' G^-1 r
+                out[t] = max(s, 0.0)
+                break
+            if not s > 0.0:
+                break
+            d = np.sqrt(s)
+            A[j, j] = d
+            for i in range(j + 1, q):
+                s2 = A[i, j]
+                for l in range(j):
+                    s2 -= A[i, l] * A[j, l]
+                A[i, j] = s2 / d
+    return out
 
 
 class ThresholdSegmenter(Segmenter):
