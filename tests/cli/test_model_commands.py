@@ -363,3 +363,39 @@ def test_help_does_not_import_the_numerical_libraries():
             "print(heavy); sys.exit(1 if heavy else 0)")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stdout + proc.stderr
+
+
+def test_identify_reports_a_cascade_of_region_warnings_in_one_line():
+    """The summary's ``warnings``: drops that follow each other (26 -> 11 -> 8 regions) in one line,
+    several ill-conditioned regions in one line, at the place of the first; other messages as they
+    came, each once; drops that do not chain (two fits) kept apart."""
+    import warnings as w
+
+    from hwpts.commands.model import _warning_lines
+    from hwpts.identification import RegionWarning
+
+    def caught(*messages):
+        with w.catch_warnings(record=True) as got:
+            w.simplefilter("always")
+            for m in messages:
+                w.warn(m)
+        return [g.message for g in got]
+
+    def dropped(a, b):
+        return RegionWarning(f"{a - b} of {a} regions received no training sample and were dropped; "
+                             f"the model has {b} regions", "dropped", before=a, after=b)
+
+    def ill(region, cond):
+        return RegionWarning(f"region {region}: ill-conditioned {cond}", "ill_conditioned", region=region,
+                             condition=cond)
+
+    lines = _warning_lines(caught(dropped(26, 11), UserWarning("other"), ill(4, 6.07e16), dropped(11, 8),
+                                  ill(2, 1.26e16), UserWarning("other")))
+    assert lines == [
+        "18 of 26 regions received no training sample and were dropped (26 -> 11 -> 8); the model has 8 regions",
+        "other",
+        "regions 2, 4: least squares is ill-conditioned (condition numbers 1.26e+16, 6.07e+16); their inputs "
+        "may not be exciting enough, consider a ridge penalty",
+    ]
+    assert _warning_lines(caught(dropped(5, 4))) == [str(dropped(5, 4))]  # one: as it was said
+    assert _warning_lines(caught(dropped(5, 4), dropped(3, 2))) == [str(dropped(5, 4)), str(dropped(3, 2))]

@@ -321,9 +321,11 @@ def test_search_passes_on_what_the_chosen_refit_says():
     x = np.random.default_rng(0).uniform(-1, 1, (800, 3))
     y = np.where(x[:, 0] >= 0, x[:, 0] + 2.0, -x[:, 1] - 1.0)
     est = PWARX(0, [1, 1, 1], [0, 0, 0], segmentation="alternating", random_state=0, partition_columns=["u3(k)"])
-    with pytest.warns(RegionWarning, match="dropped"):
+    with pytest.warns(RegionWarning, match="dropped") as said:
         search = PWARXSearch(est, param_grid={"n_regions": [2]}, try_polish=False).fit(x, y)
     assert search.best_estimator_.n_regions_ == 1
+    drop = [r.message for r in said if getattr(r.message, "kind", None) == "dropped"]
+    assert drop and drop[-1].details == {"before": 2, "after": 1}  # passed on with its numbers
     with warnings.catch_warnings():  # the same search on data that need no warning: none
         warnings.simplefilter("error", RegionWarning)
         PWARXSearch(PWARX(0, [1, 1, 1], [0, 0, 0], segmentation="average", n_regions=1),

@@ -430,12 +430,63 @@ def cmd_identify(args) -> int:
                       sample_time=dt, units=units)
     elapsed = time.perf_counter() - t0
     summary = _fit_summary(model, data, args.data, args.out, elapsed, search)
-    notes = list(dict.fromkeys(str(w.message) for w in caught if issubclass(w.category, UserWarning)))
+    notes = _warning_lines([w.message for w in caught if issubclass(w.category, UserWarning)])
     if notes:
         summary["warnings"] = notes
     save_model(model, args.out)
     print(json_text(summary))
     return 0
+
+
+def _warning_lines(messages) -> list[str]:
+    """The summary's ``warnings``: each message once, in the order they came, with the region
+    warnings of one kind in one line (a cascade of drops, 26 -> 11 -> 8 regions, or several
+    ill-conditioned or starved regions), at the place of the first."""
+    from hwpts.identification.local_models import RegionWarning
+
+    groups: dict[str, list] = {}
+    lines: list = []  # strings, or the kind of a group (filled in below)
+    for message in messages:
+        kind = getattr(message, "kind", None) if isinstance(message, RegionWarning) else None
+        if kind in ("dropped", "ill_conditioned", "starved"):
+            if kind not in groups:
+                groups[kind] = []
+                lines.append((kind,))
+            groups[kind].append(message)
+        else:
+            lines.append(str(message))
+    out = []
+    for line in lines:
+        if isinstance(line, tuple):
+            group = groups[line[0]]
+            chained = line[0] != "dropped" or all(a.details["after"] == b.details["before"]
+                                                   for a, b in zip(group[:-1], group[1:]))
+            if len(group) == 1 or not chained:
+                out.extend(str(w) for w in group)
+            else:
+                out.append(_merged(line[0], [w.details for w in group]))
+        else:
+            out.append(line)
+    return list(dict.fromkeys(out))
+
+
+def _merged(kind: str, details: list[dict]) -> str:
+    """One line for several region warnings of one ``kind`` (see :func:`_warning_lines`)."""
+    if kind == "dropped":
+        counts = [details[0]["before"]] + [d["after"] for d in details]
+        first, last = counts[0], counts[-1]
+        return (f"{first - last} of {first} regions received no training sample and were dropped "
+                f"({' -> '.join(str(c) for c in counts)}); the model has {last} regions")
+    last = {d["region"]: d for d in details}  # a region warned twice: its last fit's numbers
+    regions = sorted(last)
+    names = ", ".join(str(r) for r in regions)
+    if kind == "ill_conditioned":
+        conds = ", ".join(f"{last[r]['condition']:.3g}" for r in regions)
+        return (f"regions {names}: least squares is ill-conditioned (condition numbers {conds}); their inputs "
+                f"may not be exciting enough, consider a ridge penalty")
+    rows = ", ".join(str(last[r]["rows"]) for r in regions)
+    return (f"regions {names} have {rows} samples for {last[regions[0]]['parameters']} parameters; their "
+            f"parameters are the minimum-norm least-squares solution")
 
 
 def _validate_numbers(model, data):

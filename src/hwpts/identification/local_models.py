@@ -26,7 +26,19 @@ ILL_CONDITIONED = 1e10
 
 
 class RegionWarning(UserWarning):
-    """A region has too few samples for its parameters, or its least squares is ill-conditioned."""
+    """A region has too few samples for its parameters, or its least squares is ill-conditioned,
+    or regions were dropped for want of training samples.
+
+    ``kind`` says which, with its numbers in ``details``: ``"starved"`` (``region``, 1-based;
+    ``rows``, ``parameters``), ``"ill_conditioned"`` (``region``, ``condition``), ``"dropped"``
+    (``before``, ``after``: the region counts); tools that collect the warnings of a fit use them
+    (``hwpts identify`` reports a cascade of drops, or several ill-conditioned regions, in one line).
+    """
+
+    def __init__(self, message: str, kind: str | None = None, **details):
+        super().__init__(message)
+        self.kind = kind
+        self.details = details
 
 
 @dataclass
@@ -193,10 +205,10 @@ def fit_local_models(X: np.ndarray, y: np.ndarray, labels: np.ndarray, n_regions
             cov[i, -1, -1] = float(np.var(y[mask], ddof=1)) / counts[i] if counts[i] > 1 else np.nan
             continue
         if warn and counts[i] < n_par:
-            warnings.warn(
+            warnings.warn(RegionWarning(
                 f"region {i + 1} has {counts[i]} samples for {n_par} parameters; its parameters are "
-                f"the minimum-norm least-squares solution", RegionWarning, stacklevel=2,
-            )
+                f"the minimum-norm least-squares solution", "starved", region=i + 1, rows=int(counts[i]),
+                parameters=n_par), stacklevel=2)
         Xi, yi = X[mask], y[mask]
         theta[i], cond[i], G, scale = _fit_region(Xi, yi, constant, ridge)
         if trim is not None and counts[i] > 2 * n_par:
@@ -211,9 +223,8 @@ def fit_local_models(X: np.ndarray, y: np.ndarray, labels: np.ndarray, n_regions
             G = A.T @ A
         cov[i] = _covariance(Xi, yi, theta[i], constant, G, scale)
         if warn and counts[i] >= n_par and cond[i] > ILL_CONDITIONED:
-            warnings.warn(
+            warnings.warn(RegionWarning(
                 f"region {i + 1}: least squares is ill-conditioned (condition number {cond[i]:.3g}); "
                 f"its inputs may not be exciting enough, consider a ridge penalty",
-                RegionWarning, stacklevel=2,
-            )
+                "ill_conditioned", region=i + 1, condition=float(cond[i])), stacklevel=2)
     return LocalModels(theta, kinds, counts.astype(np.int64), cond, cov)

@@ -32,10 +32,9 @@ def drop_empty_regions(labels, s):
     keep = np.flatnonzero(counts > 0)
     if keep.size == s:
         return labels, s
-    warnings.warn(
+    warnings.warn(RegionWarning(
         f"{s - keep.size} of {s} regions received no training sample and were dropped; "
-        f"the model has {keep.size} regions", RegionWarning, stacklevel=3,
-    )
+        f"the model has {keep.size} regions", "dropped", before=int(s), after=int(keep.size)), stacklevel=3)
     remap = np.full(s, -1)
     remap[keep] = np.arange(keep.size)
     return remap[labels], int(keep.size)

@@ -762,7 +762,7 @@ class PWARXSearch(BaseEstimator):
                 row["error"] = why
                 continue
             for w in said:
-                warnings.warn(str(w.message), w.category, stacklevel=3)
+                warnings.warn(w.message, stacklevel=3)  # the warning itself (its kind and numbers)
             row["chosen"] = True
             self._rank(table)
             self.best_params_ = params
