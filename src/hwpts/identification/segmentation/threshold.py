@@ -256,6 +256,8 @@ def _sse_pairs(C, ia, ib, p, ridge):
     bad = np.flatnonzero(np.isnan(out))
     if bad.size:
         S = C[ib[bad]] - C[ia[bad]] if pairs else C[bad]
+        finite = np.all(np.isfinite(S), axis=(1, 2))  # rows with nan or inf keep a nan cost
+        bad, S = bad[finite], S[finite]
         G = S[:, :p, :p] + ridge * np.eye(p)
         r = S[:, :p, p]
         theta = np.einsum("nij,nj->ni", np.linalg.pinv(G), r)
