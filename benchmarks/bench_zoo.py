@@ -241,13 +241,12 @@ def main(argv=None) -> int:
         return 0
     n_seeds = 10
     systems = list(zoo.SYSTEMS)
-    runs = None  # (label, system, generator settings)
     for a in argv:
         if a.startswith("--seeds="):
             n_seeds = int(a.split("=", 1)[1])
         elif a.startswith("--systems="):
             systems = a.split("=", 1)[1].split(",")
-    if "--variants" in argv:
+    if "--variants" in argv:  # (label, system, generator settings)
         runs = [(label, "pwarx_random", kw) for label, kw in VARIANTS.items()]
     else:
         runs = [(name, name, None) for name in systems]

@@ -447,7 +447,7 @@ def _warning_lines(messages) -> list[str]:
     groups: dict[str, list] = {}
     lines: list = []  # strings, or the kind of a group (filled in below)
     for message in messages:
-        kind = getattr(message, "kind", None) if isinstance(message, RegionWarning) else None
+        kind = message.kind if isinstance(message, RegionWarning) else None
         if kind in ("dropped", "ill_conditioned", "starved"):
             if kind not in groups:
                 groups[kind] = []

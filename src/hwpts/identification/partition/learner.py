@@ -18,7 +18,7 @@ import numpy as np
 
 from hwpts.identification.partition.polyhedra import fit_linear_partition
 
-__all__ = ["PartitionLearner", "drop_empty_regions", "TRIM"]
+__all__ = ["PartitionLearner", "drop_empty_regions", "noise_variance", "confident_rows", "TRIM"]
 
 TRIM = 3.0  # outlier threshold (robust std) of the local least squares of learned partitions
 
@@ -38,6 +38,24 @@ def drop_empty_regions(labels, s):
     remap = np.full(s, -1)
     remap[keep] = np.arange(keep.size)
     return remap[labels], int(keep.size)
+
+
+def noise_variance(squared_residuals, scale: float = 1.0) -> float:
+    """The residual variance from the rows' squared residuals under their own mode, robustly: the
+    median over 0.4549 (the median of a chi-square with one degree of freedom), plus ``1e-12``
+    of ``scale`` (the data's variance) so that an exact fit does not divide by zero."""
+    return float(np.median(squared_residuals)) / 0.4549 + 1e-12 * scale
+
+
+def confident_rows(cost, labels, margin: float, n_labels: int, min_rows: int):
+    """Rows whose best entry of ``cost`` (rows x modes) beats the second by more than ``margin``:
+    the rows that say where a mode lives (a row two modes explain alike does not). Every row when
+    that would leave some label of ``labels`` (``0 .. n_labels-1``) with fewer than ``min_rows``."""
+    ordered = np.sort(cost, axis=1)
+    confident = (ordered[:, 1] - ordered[:, 0]) > margin
+    if np.bincount(labels[confident], minlength=n_labels).min() < min_rows:
+        confident[:] = True
+    return confident
 
 
 class PartitionLearner:
@@ -101,14 +119,11 @@ class PartitionLearner:
             local = fit_local_models(X, y, labels, s, constant, ("affine",) * s, self.ridge, warn=False, trim=self.trim)
             R = local.residuals(X, y) ** 2
             assigned = R[np.arange(len(y)), labels]
-            sigma2 = float(np.median(assigned)) / 0.4549 + 1e-12 * (np.var(y) + 1e-300)
+            sigma2 = noise_variance(assigned, np.var(y) + 1e-300)
             logp = partition.log_proba(X) if partition.n_regions == s else None
             cost = R / sigma2 - (logp if logp is not None else 0.0)
-            order = np.sort(cost, axis=1)
             proposal = np.argmin(cost, axis=1)
-            confident = (order[:, 1] - order[:, 0]) > self.confidence_margin
-            if np.bincount(proposal[confident], minlength=s).min() < p:
-                confident[:] = True
+            confident = confident_rows(cost, proposal, self.confidence_margin, s, p)
             confident = self._informative(confident, logp, rng)
             train_X, train_labels = X[confident], proposal[confident]
             previous = partition if partition.n_regions == s else None

@@ -36,6 +36,7 @@ from __future__ import annotations
 import numpy as np
 
 from hwpts.errors import ParameterError
+from hwpts.identification.partition.learner import confident_rows, noise_variance
 from hwpts.identification.segmentation.alternating import SUBSET, _fit_thetas, alternate
 from hwpts.identification.segmentation.base import SegmentationResult, Segmenter, kmeans_labels, standardize
 
@@ -142,12 +143,8 @@ class SwitchedSegmenter(Segmenter):
         Phi = np.hstack([Z, np.ones((n, 1))])
         theta = _fit_thetas(Phi, ys, mode, K, 1e-8)
         R = (ys[:, None] - Phi @ theta.T) ** 2
-        sigma2 = float(np.median(R[np.arange(n), mode])) / 0.4549 + 1e-12
-        ordered = np.sort(R / sigma2, axis=1)
-        confident = ordered[:, 1] - ordered[:, 0] > self.confidence_margin
-        p = Z.shape[1] + 1
-        if np.bincount(mode[confident], minlength=K).min() < p:
-            confident[:] = True
+        sigma2 = noise_variance(R[np.arange(n), mode])  # ys standardised: the scale is 1
+        confident = confident_rows(R / sigma2, mode, self.confidence_margin, K, Z.shape[1] + 1)
         return mode, confident, mse
 
     def _split(self, Z, regions, owner, mode, k, j, wrong_rows, rng, screen):

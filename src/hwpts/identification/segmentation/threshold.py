@@ -234,9 +234,6 @@ def _refine_cuts(xs, order, Phi, y, nodes, C, cuts, min_rows, ridge, rounds=3):
 def _sse_many(S, p, ridge):
     """Residual sums of squares of least squares from stacked augmented Gram matrices
     ``S = [Phi y]' [Phi y]`` (k, p + 1, p + 1) of blocks of rows (a ``ridge`` on the diagonal)."""
-    S = np.ascontiguousarray(S, dtype=float)
-    if S.shape[0] == 0:
-        return np.zeros(0)
     return _sse_pairs(S, None, None, p, ridge)
 
 
