@@ -26,7 +26,8 @@ approximations) have no oracle row: PyPARC is their reference.
 (:data:`VARIANTS`: other instances, orders, numbers of modes, partitions, noise, and modes sharing
 parameters), the systems the default was not tuned on.
 
-``python -m benchmarks zoo [--seeds=N] [--systems=a,b] [--variants] [--no-peers]``
+``python -m benchmarks zoo [--seeds=N] [--systems=a,b] [--variants] [--no-peers]`` (with ``--variants``,
+``--systems`` names variants)
 """
 
 from __future__ import annotations
@@ -240,14 +241,21 @@ def main(argv=None) -> int:
         print(f"zoo benchmark skipped: {ZOO_PATH} not found (set HWPTS_ZOO)")
         return 0
     n_seeds = 10
-    systems = list(zoo.SYSTEMS)
+    variants = "--variants" in argv
+    known = list(VARIANTS) if variants else list(zoo.SYSTEMS)
+    systems = known
     for a in argv:
         if a.startswith("--seeds="):
             n_seeds = int(a.split("=", 1)[1])
-        elif a.startswith("--systems="):
-            systems = a.split("=", 1)[1].split(",")
-    if "--variants" in argv:  # (label, system, generator settings)
-        runs = [(label, "pwarx_random", kw) for label, kw in VARIANTS.items()]
+        elif a.startswith("--systems="):  # with --variants: variant labels
+            systems = [s for s in a.split("=", 1)[1].split(",") if s]
+            unknown = [s for s in systems if s not in known]
+            if unknown or not systems:
+                print(f"zoo: --systems: expected names among {', '.join(known)}; got {', '.join(unknown) or 'none'}",
+                      file=sys.stderr)
+                return 2
+    if variants:  # (label, system, generator settings)
+        runs = [(label, "pwarx_random", VARIANTS[label]) for label in systems]
     else:
         runs = [(name, name, None) for name in systems]
     pyparc_py = None
