@@ -141,3 +141,32 @@ def test_local_covariance_is_sigma2_times_the_inverse_normal_matrix(n, n_feature
     expected = float(r @ r) / (n - p) * np.linalg.inv(Phi.T @ Phi)
     got = models.covariance[0] if constant else models.covariance[0, :-1, :-1]
     np.testing.assert_allclose(got, expected, rtol=1e-6, atol=1e-12 * np.abs(expected).max())
+
+
+@SETTINGS
+@given(n=st.integers(12, 400), n_features=st.integers(1, 6), n_regions=st.integers(1, 3), constant=st.booleans(),
+       ridge=st.sampled_from([0.0, 1e-4, 1e-1]), seed=st.integers(0, 2**16))
+def test_local_least_squares_is_the_scaled_ridge_solution(n, n_features, n_regions, constant, ridge, seed):
+    """Each region's parameters (eq. 17) are the least squares of ``[X 1]`` with each column over
+    its root mean square and ``ridge * n`` on the scaled regressors' diagonal, whichever path solved
+    them (normal equations formed from ``X' X``, or the SVD)."""
+    from hwpts.identification.local_models import fit_local_models
+
+    rng = np.random.default_rng(seed)
+    X = rng.standard_normal((n, n_features)) * 10.0 ** rng.uniform(-3, 3, n_features) + rng.uniform(-5, 5, n_features)
+    y = rng.standard_normal(n)
+    labels = np.arange(n) % n_regions
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        models = fit_local_models(X, y, labels, n_regions, constant, ridge=ridge)
+    for i in range(n_regions):
+        Xi, yi = X[labels == i], y[labels == i]
+        Phi = np.hstack([Xi, np.ones((len(yi), 1))]) if constant else Xi
+        scale = np.sqrt(np.mean(Phi**2, axis=0))
+        A, b = Phi / scale, yi
+        if ridge > 0:
+            A = np.vstack([A, np.sqrt(ridge * len(yi)) * np.eye(n_features, A.shape[1])])
+            b = np.concatenate([yi, np.zeros(n_features)])
+        expected = np.linalg.lstsq(A, b, rcond=None)[0] / scale
+        got = models.theta[i] if constant else models.theta[i, :-1]
+        np.testing.assert_allclose(got * scale, expected * scale, rtol=1e-6, atol=1e-8)
