@@ -149,7 +149,7 @@ def test_local_covariance_is_sigma2_times_the_inverse_normal_matrix(n, n_feature
 def test_local_least_squares_is_the_scaled_ridge_solution(n, n_features, n_regions, constant, ridge, seed):
     """Each region's parameters (eq. 17) are the least squares of ``[X 1]`` with each column over
     its root mean square and ``ridge * n`` on the scaled regressors' diagonal, whichever path solved
-    them (normal equations formed from ``X' X``, or the SVD)."""
+    them (normal equations or the SVD): what any faster formulation must keep."""
     from hwpts.identification.local_models import fit_local_models
 
     rng = np.random.default_rng(seed)
