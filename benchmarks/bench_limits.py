@@ -15,8 +15,11 @@ Two questions the zoo and real-data benchmarks leave open, answered with numbers
 2. **Silverbox's arrow record is partly an extrapolation test**: the default search's model
    (orders and everything chosen on the training part) has its arrow error split between the
    samples near outputs beyond the training record's range and the rest.
+3. **EMPS's test score is a draw of the polish**: the default search's model on EMPS, its
+   simulation-error polish started again from the least-squares estimate times
+   ``1 + 1e-9 N(0, 1)`` (seeds 1, 2, ...): the training fits hardly move, the test RMSE does.
 
-``python -m benchmarks limits [--seeds=N] [--systems=a,b] [--no-silverbox]``
+``python -m benchmarks limits [--seeds=N] [--systems=a,b] [--no-silverbox] [--no-emps] [--draws=N]``
 """
 
 from __future__ import annotations
@@ -29,6 +32,8 @@ import numpy as np
 
 DEFAULT_SEEDS = 10
 NEAR = 100  # samples on either side of an output beyond the training range count as "near" it
+DRAWS = 7  # EMPS: perturbed starts of the polish
+PERTURBATION = 1e-9  # EMPS: relative size of the perturbation of the polish's start
 
 
 def _pairwise_svm(Z, labels, Zv, n_modes, C=1e4):
@@ -121,17 +126,59 @@ def silverbox_extrapolation():
             "params": search.best_params_, "time": elapsed}
 
 
+def emps_polish_spread(draws=DRAWS, eps=PERTURBATION):
+    """The default search's model on EMPS and the same model polished from perturbed starts: the
+    unpolished, polished and perturbed models' training free-run fit % and test RMSE [mm]; None
+    when the data are absent."""
+    import copy
+
+    from benchmarks.bench_real import DATA, SETS, _free_run, _load, _score
+    from hwpts.identification import PWARX, PWARXSearch
+    from hwpts.identification.polish import polish_free_run
+
+    cfg = SETS["emps"]
+    if not (DATA / cfg["train"][0]).exists():
+        return None
+    u, y = _load(cfg["train"], cfg["u"], cfg["y"])
+    ut, yt = _load(cfg["tests"]["test"], cfg["u"], cfg["y"])
+    n_init = cfg.get("n_init", 0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        search = PWARXSearch(PWARX(random_state=0), orders="auto").fit(u, y)
+        params = dict(search.best_params_)
+        least_squares = PWARX(random_state=0).set_params(**{**params, "polish": False}).fit(u, y)
+
+        def scores(model):
+            yh, n0 = _free_run(model, ut, yt, n_init)
+            return model.simulate(u, y).score(y), _score(cfg, yt, yh, n0)
+
+        rows = [("least squares", *scores(least_squares)), ("chosen (polished)", *scores(search.best_estimator_))]
+        center, half = least_squares.divergence_band()
+        for seed in range(1, draws + 1):
+            rng = np.random.default_rng(seed)
+            start = least_squares.theta_ * (1.0 + eps * rng.standard_normal(least_squares.theta_.shape))
+            theta, _ = polish_free_run(least_squares.structure_, least_squares.partition_, start,
+                                       least_squares.region_models_, u, y, center, half)
+            model = copy.deepcopy(least_squares)
+            model.theta_ = theta
+            rows.append((f"start perturbed, seed {seed}", *scores(model)))
+    return {"params": params, "rows": rows, "eps": eps}
+
+
 def main(argv=None) -> int:
     from benchmarks.bench_zoo import load_zoo
 
     argv = list(argv or [])
     seeds = DEFAULT_SEEDS
     systems = None
+    draws = DRAWS
     for a in argv:
         if a.startswith("--seeds="):
             seeds = int(a.split("=", 1)[1])
         elif a.startswith("--systems="):
             systems = a.split("=", 1)[1].split(",")
+        elif a.startswith("--draws="):
+            draws = int(a.split("=", 1)[1])
     zoo = load_zoo()
     if zoo is None:
         print("limits: the zoo (../shared/benchmarks/pwarx_zoo.py) was not found; boundary part skipped")
@@ -152,12 +199,36 @@ def main(argv=None) -> int:
             cells = [f"{r[k]['fit']:6.1f} [{r[k]['acc']:6.2f}, {r[k]['wrong']:4.0f}]" for k in ("logistic", "svm", "nearest")]
             print(f"{name:15s} {r['n_validation']:6d} {r['oracle']['fit']:7.1f} " + " ".join(f"{c:>24s}" for c in cells))
         print(f"   ({time.perf_counter() - t0:.1f} s)")
-    if "--no-silverbox" in argv:
-        return 0
+    if "--no-silverbox" not in argv:
+        _print_silverbox()
+    if "--no-emps" not in argv:
+        _print_emps(draws)
+    return 0
+
+
+def _print_emps(draws):
+    em = emps_polish_spread(draws)
+    if em is None:
+        print("3. EMPS skipped: ../shared/data/emps not found (set HWPTS_DATA_DIR)")
+        return
+    p = em["params"]
+    print(f"3. EMPS, the default search's model (na {p.get('output_order')}, nb {p.get('input_order')}, "
+          f"nk {p.get('input_delay')}, {p.get('segmentation')}, {p.get('n_regions')} regions"
+          f"{', polished' if p.get('polish') else ''}); the polish started from the least-squares estimate "
+          f"times 1 + {em['eps']:g} N(0, 1)")
+    print(f"   {'model':28s} {'training fit %':>15s} {'test RMSE mm':>13s}")
+    for name, fit, test in em["rows"]:
+        print(f"   {name:28s} {fit:15.3f} {test:13.2f}")
+    polished = [test for name, _, test in em["rows"][1:]]
+    print(f"   polished models: test RMSE median {np.nanmedian(polished):.2f} mm, range "
+          f"[{np.nanmin(polished):.2f}, {np.nanmax(polished):.2f}] mm (target 5.17 mm)")
+
+
+def _print_silverbox():
     sb = silverbox_extrapolation()
     if sb is None:
         print("2. Silverbox skipped: ../shared/data/silverbox not found (set HWPTS_DATA_DIR)")
-        return 0
+        return
     p = sb["params"]
     print(f"2. Silverbox, the default search's model (na {p.get('output_order')}, nb {p.get('input_order')}, "
           f"{p.get('segmentation')}, {p.get('n_regions')} regions{', polished' if p.get('polish') else ''}; "
@@ -169,7 +240,6 @@ def main(argv=None) -> int:
           f"of samples within {NEAR} samples of an output beyond the training range, {sb['rmse_away']:.2f} mV "
           f"over the rest")
     print("   RMSE per tenth of the record [mV]: " + ", ".join(f"{t:.2f}" for t in sb["tenths"]))
-    return 0
 
 
 if __name__ == "__main__":
