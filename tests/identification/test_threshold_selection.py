@@ -4,7 +4,7 @@ import warnings
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from hwpts.errors import ParameterError
@@ -400,3 +400,69 @@ def test_columns_screened_on_a_coarse_grid_keep_the_switching_column(monkeypatch
     assert screened["column"] == full["column"] == "u3(k-1)"
     assert screened["thresholds"] == full["thresholds"]
     assert abs(screened["thresholds"][0] + 0.25) < 0.02
+
+
+def _two_region_record(n=600, seed=1):
+    """Noise-free y(k) = 0.5 y(k-1) + u(k-1) + 0.2 where y(k-1) >= 0, -0.4 y(k-1) + 0.8 u(k-1) - 0.3
+    elsewhere."""
+    rng = np.random.default_rng(seed)
+    u = rng.uniform(-1, 1, n)
+    y = np.zeros(n)
+    for k in range(1, n):
+        y[k] = 0.5 * y[k - 1] + u[k - 1] + 0.2 if y[k - 1] >= 0 else -0.4 * y[k - 1] + 0.8 * u[k - 1] - 0.3
+    return u, y
+
+
+@settings(max_examples=12, deadline=None)
+@given(log_scale=st.sampled_from([-9, -7, -5, -3, 0, 3, 6]), offset=st.sampled_from([0.0, 1e2, 1e5, 1e6]),
+       which=st.sampled_from(["both", "output"]))
+def test_threshold_does_not_depend_on_the_data_units(log_scale, offset, which):
+    """The same system in other units or with an offset (pressure in Pa around 1e5, a position in
+    km, an output biased by 1e6) gets the same split column and the same regions. Before the block
+    costs were computed in an orthonormal basis, a ridge relative to the raw Gram matrix moved the
+    split to u(k-1) at scales 1e-5 .. 1e-9 and offsets of 1e5 and more (70 % training fit)."""
+    from hwpts.identification.segmentation import threshold as th
+
+    scale = 10.0 ** log_scale
+    assume(offset / scale <= 1e8)  # beyond, the offset's rounding (1e-16 of it) blurs the signal itself
+    u, y = _two_region_record()
+    ut = u * scale + offset if which == "both" else u
+    yt = y * scale + offset
+    th._COST_CACHE.clear()
+    ref = PWARX(1, 1, 1, n_regions=2, segmentation="threshold").fit(u[:, None], y)
+    m = PWARX(1, 1, 1, n_regions=2, segmentation="threshold").fit(ut[:, None], yt)
+    assert m.segmentation_info_["column"] == ref.segmentation_info_["column"] == "y(k-1)"
+    np.testing.assert_array_equal(m.predict_regions(ut[:, None], yt), ref.predict_regions(u[:, None], y))
+    assert fit_percent(yt[1:], m.predict(ut[:, None], yt)[1:]) > 99.99
+
+
+def test_threshold_costs_are_exact_on_collinear_lags():
+    """A smooth, finely sampled position (a mass pushed by a force through two friction levels, as
+    EMPS's) has four lagged outputs whose Gram matrix is conditioned around 1e12: the split's
+    reported residual sum of squares is least squares' on its regions, and more regions never cost
+    more. On the raw rows the Cholesky pivot cancelled: costs 10-60x the true ones, a 3-region split
+    costing more than a 2-region one."""
+    rng = np.random.default_rng(0)
+    n = 6000
+    force = np.repeat(rng.uniform(-1, 1, n // 100), 100) + 0.05 * rng.standard_normal(n)
+    pos = np.zeros(n)
+    vel = 0.0
+    for k in range(1, n):
+        friction = 0.02 if pos[k - 1] < 0.05 else 0.2  # a rougher stretch of the track
+        vel = vel + 1e-3 * (force[k - 1] - friction * np.sign(vel) - 2.0 * vel)
+        pos[k] = pos[k - 1] + 1e-3 * vel
+    sse = {}
+    for s in (1, 2, 3):
+        m = PWARX(4, 1, 1, n_regions=s, segmentation="threshold").fit(force[:, None], pos)
+        X, t = m.structure_.build(force[:, None], pos)
+        labels = m.predict_regions(force[:, None], pos)[m.structure_.max_lag:]
+        direct = 0.0
+        for r in range(s):
+            A = np.column_stack([X[labels == r], np.ones(np.sum(labels == r))])
+            A = A - np.r_[A.mean(axis=0)[:-1], 0.0]  # centred, for lstsq's own accuracy
+            res = t[labels == r] - A @ np.linalg.lstsq(A, t[labels == r], rcond=None)[0]
+            direct += res @ res
+        if s > 1:
+            assert m.segmentation_info_["sse"] == pytest.approx(direct, rel=1e-4)
+        sse[s] = direct
+    assert sse[1] >= sse[2] >= sse[3]

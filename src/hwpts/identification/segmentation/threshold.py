@@ -347,8 +347,8 @@ class ThresholdSegmenter(Segmenter):
             name = self.column if self.column is not None else None
             return SegmentationResult(np.zeros(n, dtype=np.int64), 1, RegionPartition.single(nf),
                                       refine=False, info={"column": name, "thresholds": []})
-        Phi = structure.extend(X)
-        p = Phi.shape[1]
+        Phi, y, y_scale = _scaled_rows(X, y, structure)
+        p = nf + int(structure.constant)  # parameters of a local model (Phi may span fewer columns)
         min_rows = max(int(np.ceil(self.min_share * n)), p + 1)
         n_grid = grid_size(int(self.n_grid), len(columns), p)
         best = (np.inf, None, None)
@@ -376,4 +376,34 @@ class ThresholdSegmenter(Segmenter):
         labels = partition.predict(X)
         return SegmentationResult(labels, n_regions, partition, refine=False,
                                   info={"column": structure.feature_names[c],
-                                        "thresholds": [float(t) for t in thresholds], "sse": float(sse)})
+                                        "thresholds": [float(t) for t in thresholds],
+                                        "sse": float(sse) * y_scale ** 2})
+
+
+def _scaled_rows(X, y, structure):
+    """``(Phi, y, y_scale)``: the rows in a basis in which the block costs are accurate whatever the
+    data's units and the collinearity of its lags. The regressors ``[X 1]`` (centred and scaled
+    columns) are replaced by an orthonormal basis of the space they span (times ``sqrt(n)``), and
+    the output by its residual from the least squares on all rows, divided by that residual's
+    standard deviation ``y_scale``. Both are exact for every block: a block's regressors span the
+    same functions of its rows, and the removed fit lies in that span, so a block's residual sum
+    of squares is the raw one over ``y_scale ** 2``. On the raw rows the Cholesky pivot
+    ``y'y - r'G^-1 r`` cancelled: EMPS's lagged positions (na = 4) have a Gram matrix conditioned
+    around 1e12, and the block costs came out 10-60x the true residual sums, with more regions
+    costing *more* (a split into 3 blocks costing more than one of its 2-block splits); a ridge of
+    1e-10 of the Gram matrix's mean diagonal, which an offset of 1e6 or a scale of 1e-7 in the
+    data dwarfs or swamps, moved a two-region system's split to the wrong column (70 % training
+    fit instead of 100 %)."""
+    X = np.asarray(X, dtype=float)
+    y = np.asarray(y, dtype=float)
+    n = X.shape[0]
+    sd = X.std(axis=0)
+    sd[~(sd > 0)] = 1.0
+    Phi = structure.extend((X - X.mean(axis=0)) / sd) if structure.constant else X / sd
+    U, sv, _ = np.linalg.svd(Phi, full_matrices=False)
+    U = U[:, sv > sv[0] * max(Phi.shape) * np.finfo(float).eps] if sv.size and sv[0] > 0 else U[:, :0]
+    r = y - U @ (U.T @ y)
+    y_scale = float(np.sqrt(np.mean(r ** 2)))
+    if not y_scale > 0:  # an exact fit on all rows: every block's cost is zero
+        y_scale = 1.0
+    return U * np.sqrt(n), r / y_scale, y_scale
