@@ -68,7 +68,7 @@ class IODataset:
         for label, values in checks:
             if not np.all(np.isfinite(values)):
                 bad = int(np.argmax(~np.isfinite(values)))
-                raise DataError(f"column {label!r} has a non-finite value (NaN or inf) at row {bad}")
+                raise DataError(f"column {label!r} has a non-finite value (NaN, inf or an empty cell) at row {bad}")
             if label != "time" and np.any(np.abs(values) > MAX_ABS_VALUE):
                 bad = int(np.argmax(np.abs(values) > MAX_ABS_VALUE))
                 raise DataError(f"column {label!r} has the value {values[bad]:.3g} at row {bad}, beyond "

@@ -43,6 +43,10 @@ def workspace(tmp_path_factory):
     write_csv(ws / "notime.csv", {"u1": d.inputs[:, 0], "u2": d.inputs[:, 1], "y": d.output})
     write_csv(ws / "short.csv", {"time_s": t[:6], "u1": d.inputs[:6, 0], "u2": d.inputs[:6, 1], "y": d.output[:6]})
     assert main(["identify", str(ws / "data.csv"), *FIXED, "--out", str(ws / "model.json")]) == 0
+    # a model whose input has the name of a column predict writes
+    write_csv(ws / "clash.csv", {"time_s": t, "region": d.inputs[:, 0], "y": d.output})
+    assert main(["identify", str(ws / "clash.csv"), "--input", "region", "--output", "y", "--na", "1", "--nb", "1",
+                 "--segmentation", "average", "--out", str(ws / "clash.json")]) == 0
     doc = json.loads((ws / "model.json").read_text())
     files = {
         "empty.csv": "",
@@ -81,12 +85,19 @@ def workspace(tmp_path_factory):
         "inputs_back.csv": "time_s,valve_voltage_v,pump_speed_rpm\n1,2.4,700\n0,2.4,700\n",
         "inputs_rpm.csv": "time_s,valve_voltage_v,pump_speed_rpm\n0,2.4,1e9\n1,2.4,700\n",
         "afile": "x",
+        "noheader.csv": "0.0,1.0,2.0,3.0\n0.01,1.5,2.5,3.5\n",
+        "nantime.csv": "t_s,u1,u2,y\n" + "".join(f"{'' if i == 5 else i * 0.1},{i % 4},{i % 3},{i}\n" for i in range(40)),
     }
     for name, text in files.items():
         if text is not None:
             (ws / name).write_text(text)
     (ws / "garbage.csv").write_bytes(bytes(range(256)) * 8)
     (ws / "latin1.csv").write_bytes("u1,u2,y\n1,2,3\n\xe9,\xe8,\xe0\n".encode("latin-1"))
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    pq.write_table(pa.table({"u1": pa.array([], pa.float64()), "u2": pa.array([], pa.float64()),
+                             "y": pa.array([], pa.float64())}), ws / "zero.parquet")
     savemat(ws / "ragged.mat", {"u1": np.arange(10.0), "u2": np.arange(10.0), "y": np.arange(12.0)})
     savemat(ws / "good.mat", {"u1": d.inputs[:, 0], "u2": d.inputs[:, 1], "y": d.output})
     (ws / "folder").mkdir()
@@ -247,7 +258,15 @@ CASES = [
     (["residuals", f"{W}/model.json", f"{W}/data.csv", "--confidence", "high"], "--confidence"),
     (["residuals", f"{W}/missing.json", f"{W}/data.csv"], "missing.json"),
     (["residuals", f"{W}/model.json", f"{W}/data.csv", "--plot", f"{W}/data.csv.png", "--input", "a"], "--input"),
+    (["predict", f"{W}/clash.json", f"{W}/clash.csv", "--out", f"{W}/p.csv"],
+     "the signal 'region' has the name of a column predict writes"),
+    (["identify", f"{W}/noheader.csv", *FIXED, "--out", f"{W}/m.json"], "expected a header row of column names"),
+    (["identify", f"{W}/nantime.csv", *FIXED, "--out", f"{W}/m.json"], "the time column 't_s' has a non-finite value"),
+    (["identify", f"{W}/zero.parquet", *FIXED, "--out", f"{W}/m.json"], "the file holds no data rows"),
+    (["identify", f"{W}/data.csv", *FIXED, "--out", f"{W}/afile/deeper/m.json"], "which is a file"),
+    (["validate", f"{W}/model.json", f"{W}/data.csv", "--rows", "0:3"], "(--rows 0:3) has 3 rows"),
     # --- export
+    (["export", f"{W}/model.json", "--format", "json", "--out", f"{W}/folder"], "expected a file name ending in .json"),
     (["export", f"{W}/model.json", "--format", "excel", "--out", f"{W}/x.xls"], "--format"),
     (["export", f"{W}/model.json", "--format", "matlab", "--out", f"{W}/x.json"], "--out"),
     (["export", f"{W}/model.json", "--format", "json", "--out", f"{W}/model.json"], "model"),

@@ -31,6 +31,13 @@ def cmd_residuals(args) -> int:
     conf = f"{100 * result['confidence']:g} %"
     print(f"residuals: {result['n_residuals']} one-step residuals of {model.structure_.output_name!r}, "
           f"rms {result['residual_rms']:.6g}")
+    if result["exact"]:
+        print("the residuals are rounding errors (rms under 1e-9 of the output's standard deviation): the model "
+              "reproduces the data exactly, and the whiteness and input-correlation tests, which assume a "
+              "noise, do not apply")
+        if args.plot is not None:
+            print(f"wrote {args.plot}")
+        return 0
     print(f"whiteness: {100 * share['autocorrelation']:.1f} % of lags 1..{args.lags} outside the {conf} band "
           f"(+-{result['band']:.4g}) -> {'white' if result['white'] else 'NOT white'}")
     for name, value in share["cross_correlation"].items():
@@ -51,7 +58,7 @@ def cmd_export(args) -> int:
     suffix = EXPORT_FORMATS[args.format]
     if not str(args.out).lower().endswith(suffix):
         raise ParameterError(f"--out {str(args.out)!r}: --format {args.format} writes a {suffix} file; "
-                             f"name it ...{suffix}")
+                             f"expected a file name ending in {suffix}")
     model = load_model(args.model)
     doc = state_space_export(model)
     write_export(args.out, args.format, doc, f"hwpts {__version__}", str(args.model))

@@ -95,8 +95,13 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
     cols = {k: np.asarray(v)[sl] for k, v in columns.items()}
     n = len(cols[output_name])
     if n == 0:
-        raise DataError(f"{str(path)!r}: no rows selected (--rows {rows})")
+        where = f"no rows selected (--rows {rows})" if rows is not None else "the file holds no data rows"
+        raise DataError(f"{str(path)!r}: {where}")
     tname = next((c for c in candidates if c in cols), None)
+    if tname is not None and not np.all(np.isfinite(np.asarray(cols[tname], dtype=float))):
+        bad = int(np.argmax(~np.isfinite(np.asarray(cols[tname], dtype=float))))
+        raise DataError(f"{str(path)!r}: the time column {tname!r} has a non-finite value (NaN, inf or an "
+                        f"empty cell) at row {bad}")
     detected = time_name is None and tname is not None
     hint = f" ({tname!r} is taken as the time column by its name; --time none uses the sample index)" if detected else ""
     timed = tname is not None
@@ -347,7 +352,7 @@ def cmd_identify(args) -> int:
     if not searched:
         structure = RegressorStructure.create(fixed["output_order"], fixed["input_order"], fixed["input_delay"],
                                               len(args.input), True, args.input, args.output)
-        structure.check_length(data.n_samples, what=f"{args.data!s}")
+        structure.check_length(data.n_samples, what=f"{args.data!s}" + (f" (--rows {args.rows})" if args.rows else ""))
     hyperplanes = [Hyperplane.parse(h) for h in args.hyperplane]
     segmentation = args.segmentation
     if hyperplanes and segmentation is None:
@@ -530,7 +535,7 @@ def _model_and_data(args):
     _check_signals(inputs, output)
     data, dt = _load_dataset(args.data, inputs, output, args.time, args.rows)
     data = _check_sample_time(model, data, dt, args.data, args.resample)
-    st.check_length(data.n_samples, what=repr(str(args.data)))
+    st.check_length(data.n_samples, what=repr(str(args.data)) + (f" (--rows {args.rows})" if args.rows else ""))
     return model, data
 
 
@@ -583,6 +588,12 @@ def cmd_predict(args) -> int:
     model, data = _model_and_data(args)
     model.structure_.check_length(data.n_samples)
     name = data.output_name
+    written = ("time_s", f"{name}_predicted", "region")
+    clash = [nm for nm in (*data.input_names, name) if nm in written]
+    if clash:  # one dict entry would overwrite the other: a column lost without a word
+        raise DataError(f"--out: the signal {clash[0]!r} has the name of a column predict writes "
+                        f"({', '.join(written)}); expected other signal names, got {clash[0]!r} "
+                        f"(rename that column in the data and identify again)")
     if args.horizon is not None:
         if args.mode_given:
             raise ParameterError("--horizon K is a k-step prediction: do not combine it with --mode")

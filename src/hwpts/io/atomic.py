@@ -108,6 +108,9 @@ def atomic_path(path: str | os.PathLike, suffix: str | None = None):
     """
     target = check_output_path(path)
     end = suffix if suffix is not None else target.suffix + ".tmp"
+    blocker = next((a for a in target.parents if a.exists() or a.is_symlink()), None)
+    if blocker is not None and not blocker.is_dir():
+        raise DataError(f"--out {str(target)!r}: expected a path in a folder, got {str(blocker)!r}, which is a file")
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
         _remove_stale_temporaries(target, end)
