@@ -84,3 +84,21 @@ def test_parameter_std_survives_the_model_file(tmp_path):
     np.testing.assert_allclose(back.parameter_std_, model.parameter_std_, rtol=1e-12)
     np.testing.assert_allclose(back.parameter_cov_, model.parameter_cov_, rtol=1e-12)
     assert model.summary()["regions"][0]["theta_std"][0] > 0
+
+
+def test_residuals_of_an_exact_model_are_called_exact():
+    """A model that reproduces noise-free data leaves rounding errors (1e-16), which are correlated
+    with its regressors: the analysis says the fit is exact instead of failing the whiteness test;
+    on noisy data it does not."""
+    from hwpts.identification.analysis import residual_analysis
+
+    rng = np.random.default_rng(0)
+    u = rng.uniform(-1, 1, 800)
+    y = np.zeros(800)
+    for k in range(1, 800):
+        y[k] = 0.5 * y[k - 1] + u[k - 1] + 0.2 if y[k - 1] >= 0 else -0.4 * y[k - 1] + 0.8 * u[k - 1] - 0.3
+    model = PWARX(1, 1, 1, n_regions=2, segmentation="threshold").fit(u[:, None], y)
+    exact = residual_analysis(model, u[:, None], y)
+    assert exact.exact and exact.to_dict()["exact"] is True
+    noisy = y + 0.05 * rng.standard_normal(800)
+    assert not residual_analysis(model, u[:, None], noisy).exact

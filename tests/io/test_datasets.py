@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy.io import savemat
 
 from hwpts.errors import DataError
@@ -14,6 +16,20 @@ def test_csv_round_trip(tmp_path):
     cols = read_table(path)
     assert list(cols) == ["time_s", "u"]
     np.testing.assert_array_equal(cols["u"], [0.5, 1.5, -2.0])
+
+
+@settings(max_examples=30, deadline=None)
+@given(values=st.lists(st.floats(allow_nan=False, allow_infinity=False, width=64), min_size=1, max_size=20))
+def test_csv_keeps_every_digit(tmp_path_factory, values):
+    """What CSV writes reads back to the same floats: an epoch time axis sampled at 1 ms, an output
+    near 1e9 (ten significant digits, the old format, made 1.7e9 + k ms two distinct values)."""
+    path = tmp_path_factory.mktemp("digits") / "d.csv"
+    epoch = 1.7e9 + 0.001 * np.arange(len(values))
+    write_csv(path, {"time_s": epoch, "y": np.array(values), "region": np.arange(len(values))})
+    cols = read_table(path)
+    np.testing.assert_array_equal(cols["time_s"], epoch)
+    np.testing.assert_array_equal(cols["y"], values)
+    assert path.read_text().splitlines()[1].endswith(",0")  # integers stay integers
 
 
 def test_parquet_round_trip(tmp_path):

@@ -79,6 +79,9 @@ def correlation(a: np.ndarray, b: np.ndarray, lags: int) -> np.ndarray:
     return np.array([a[tau:] @ b[:n - tau] for tau in range(lags + 1)]) / denom
 
 
+EXACT_SHARE = 1e-9  # residual rms, as a share of the output's standard deviation, of an exact model
+
+
 @dataclass(frozen=True)
 class ResidualAnalysis:
     """Whiteness and independence tests of the one-step residuals (MATLAB's ``resid``).
@@ -109,6 +112,16 @@ class ResidualAnalysis:
     band: float
     autocorrelation: np.ndarray
     cross_correlation: dict
+    output_spread: float = float("nan")
+
+    @property
+    def exact(self) -> bool:
+        """Whether the residuals are rounding errors (rms under :data:`EXACT_SHARE` of the output's
+        standard deviation ``output_spread``): the model reproduces the data, and the correlation
+        tests, which assume a noise, say nothing (the rounding errors of an exact model are
+        correlated with its regressors)."""
+        rms = float(np.sqrt(np.mean(self.residuals ** 2)))
+        return bool(rms <= EXACT_SHARE * self.output_spread)
 
     @property
     def n_samples(self) -> int:
@@ -136,6 +149,7 @@ class ResidualAnalysis:
             "outside_share": share,
             "white": share["autocorrelation"] <= 0.05,
             "independent_of_inputs": all(v <= 0.05 for v in share["cross_correlation"].values()),
+            "exact": self.exact,
         }
 
 
@@ -157,7 +171,8 @@ def residual_analysis(model, inputs, output, lags: int = 25, confidence: float =
     u = np.asarray(inputs, dtype=float).reshape(y.shape[0], -1)[m:]
     band = float(norm.ppf(0.5 + float(confidence) / 2) / np.sqrt(e.shape[0]))
     cross = {name: correlation(e, u[:, j], lags) for j, name in enumerate(model.structure_.input_names)}
-    return ResidualAnalysis(e, int(lags), float(confidence), band, correlation(e, e, lags), cross)
+    return ResidualAnalysis(e, int(lags), float(confidence), band, correlation(e, e, lags), cross,
+                            float(np.std(y[m:])))
 
 
 def state_space_export(model) -> dict:

@@ -166,7 +166,8 @@ def simulate_pwarx(structure, partition, theta, inputs, initial_output, center=0
         return SimulationResult(
             yhat, regions, m, True, int(k),
             f"the free-run output left the band {center:.6g} +- {bound:.6g} at sample {k} "
-            f"(unstable switched dynamics)",
+            f"(the switched dynamics are unstable on this input, or it drives the model far outside the "
+            f"range it was identified on)",
         )
     return SimulationResult(yhat, regions, m)
 

@@ -90,8 +90,9 @@ def read_csv(path: str | os.PathLike, columns=None) -> dict[str, np.ndarray]:
         return _read_csv_python(p, delimiter, columns)  # raises the precise error
     # an unnamed column with no value (a trailing delimiter on every row) is not a column
     keep = [i for i, n in enumerate(names) if n or table.column(i).null_count < table.num_rows]
-    if any(not names[i] for i in keep) or len({names[i] for i in keep}) != len(keep):
-        return _read_csv_python(p, delimiter, columns)  # empty or duplicate names: said precisely
+    if any(not names[i] for i in keep) or len({names[i] for i in keep}) != len(keep) \
+            or all(_is_number(names[i]) for i in keep):
+        return _read_csv_python(p, delimiter, columns)  # empty, duplicate or numeric names: said precisely
     if table.num_rows == 0:
         raise DataError(f"{str(p)!r}: no data rows after the header")
     wanted = [i for i in keep if columns is None or names[i] in set(columns)]
@@ -103,6 +104,14 @@ def read_csv(path: str | os.PathLike, columns=None) -> dict[str, np.ndarray]:
             return _read_csv_python(p, delimiter, columns)
         out[name] = column.cast(pa.float64()).to_numpy(zero_copy_only=False)
     return out
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 def _read_csv_python(p: Path, delimiter: str = ",", columns=None) -> dict[str, np.ndarray]:
@@ -120,6 +129,9 @@ def _read_csv_python(p: Path, delimiter: str = ",", columns=None) -> dict[str, n
     header = [h.strip() for h in rows[0]]
     while header and not header[-1]:  # trailing empty columns (a comma at the end of every row)
         header.pop()
+    if header and all(_is_number(h) for h in header):
+        raise DataError(f"{str(p)!r}: expected a header row of column names first, got numbers "
+                        f"({delimiter.join(header[:4])}{', ...' if len(header) > 4 else ''})")
     if len(set(header)) != len(header):
         dup = sorted({h for h in header if header.count(h) > 1})
         raise DataError(f"{str(p)!r}: duplicate column name(s) {dup}")
@@ -148,8 +160,23 @@ def _read_csv_python(p: Path, delimiter: str = ",", columns=None) -> dict[str, n
     return {header[j]: values[:, j].copy() for j in wanted}
 
 
-def csv_text(columns: Mapping[str, np.ndarray], fmt: str = "%.10g") -> str:
-    """Named columns of equal length as CSV text (header row, comma-separated)."""
+def _cells(a: np.ndarray, fmt: str | None) -> list:
+    """The CSV cells of one column: strings as they are, integers as integers, floats with ``fmt``
+    or, by default, the shortest text that reads back to the same number (Python's ``repr``): ten
+    significant digits turned an epoch time axis (1.7e9 s sampled at 1 ms) into two distinct
+    values, and an output near 1e9 into steps of 1."""
+    if a.dtype.kind in "USO":
+        return a.astype(str).tolist()
+    if a.dtype.kind in "iub":
+        return a.astype(np.int64).astype(str).tolist()
+    if fmt is not None:
+        return np.char.mod(fmt, a.astype(float)).tolist()
+    return [repr(v) for v in a.astype(float).tolist()]
+
+
+def csv_text(columns: Mapping[str, np.ndarray], fmt: str | None = None) -> str:
+    """Named columns of equal length as CSV text (header row, comma-separated); floats exact
+    (see :func:`_cells`) unless ``fmt`` (a ``%`` format) says otherwise."""
     names = list(columns)
     arrays = [np.asarray(columns[n]) for n in names]
     n = {a.shape[0] for a in arrays}
@@ -157,16 +184,14 @@ def csv_text(columns: Mapping[str, np.ndarray], fmt: str = "%.10g") -> str:
         raise DataError(f"columns have different lengths: { {k: a.shape[0] for k, a in zip(names, arrays)} }")
     buf = io.StringIO()
     buf.write(",".join(names) + "\n")
-    formatted = [
-        a.astype(str) if a.dtype.kind in "USO" else np.char.mod(fmt, a.astype(float)) for a in arrays
-    ]
+    formatted = [_cells(a, fmt) for a in arrays]
     if formatted:
         buf.write("\n".join(",".join(row) for row in zip(*formatted)))
         buf.write("\n")
     return buf.getvalue()
 
 
-def write_csv(path: str | os.PathLike, columns: Mapping[str, np.ndarray], fmt: str = "%.10g") -> None:
+def write_csv(path: str | os.PathLike, columns: Mapping[str, np.ndarray], fmt: str | None = None) -> None:
     """Write named columns of equal length to CSV, atomically. String columns are written as is."""
     write_text_atomic(path, csv_text(columns, fmt))
 
