@@ -1,6 +1,6 @@
 """``python -m hwpts`` runs the command-line interface."""
 
-from hwpts.cli import entry
+from hwpts._console import entry
 
 if __name__ == "__main__":
     entry()

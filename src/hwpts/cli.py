@@ -195,7 +195,11 @@ def entry() -> None:  # pragma: no cover - the console script, exercised in subp
     landed inside a compiled library (LLVM compiling a numba kernel) can leave it in a state whose
     teardown at interpreter exit crashes; every output and temporary file is already settled.
     """
-    status = main()
+    finish(main())
+
+
+def finish(status: int) -> None:  # pragma: no cover - the console script's exit
+    """Exit with ``status``; after an interrupt (130) at once (see :func:`entry`)."""
     if status == 130:
         sys.stdout.flush()
         sys.stderr.flush()
