@@ -42,24 +42,16 @@ NO_TIME = "none"  # --time none: no time column, the sample index is the time ax
 def _available(path, found) -> str:
     """The file's columns for an error message (those read so far if the whole file cannot be read),
     with a hint when its first row holds numbers (no header row)."""
-    from hwpts.io.datasets import read_table
+    from hwpts.io.datasets import is_number, read_table
 
     try:
         names = sorted(read_table(path))
     except (DataError, OSError, ValueError):
         names = sorted(found)
     text = f"available columns are {names}"
-    if not names or all(_is_number(n) for n in names):
+    if not names or all(is_number(n) for n in names):
         text += " (the first row must name the columns: a header row such as u,y)"
     return text
-
-
-def _is_number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
 
 
 def _load_dataset(path, input_names, output_name, time_name=None, rows=None):

@@ -91,7 +91,7 @@ def read_csv(path: str | os.PathLike, columns=None) -> dict[str, np.ndarray]:
     # an unnamed column with no value (a trailing delimiter on every row) is not a column
     keep = [i for i, n in enumerate(names) if n or table.column(i).null_count < table.num_rows]
     if any(not names[i] for i in keep) or len({names[i] for i in keep}) != len(keep) \
-            or all(_is_number(names[i]) for i in keep):
+            or all(is_number(names[i]) for i in keep):
         return _read_csv_python(p, delimiter, columns)  # empty, duplicate or numeric names: said precisely
     if table.num_rows == 0:
         raise DataError(f"{str(p)!r}: no data rows after the header")
@@ -106,7 +106,8 @@ def read_csv(path: str | os.PathLike, columns=None) -> dict[str, np.ndarray]:
     return out
 
 
-def _is_number(text: str) -> bool:
+def is_number(text: str) -> bool:
+    """Whether ``text`` reads as a float (a header cell that is a number: no header row)."""
     try:
         float(text)
     except ValueError:
@@ -129,8 +130,8 @@ def _read_csv_python(p: Path, delimiter: str = ",", columns=None) -> dict[str, n
     header = [h.strip() for h in rows[0]]
     while header and not header[-1]:  # trailing empty columns (a comma at the end of every row)
         header.pop()
-    if header and all(_is_number(h) for h in header):
-        raise DataError(f"{str(p)!r}: expected a header row of column names first, got numbers "
+    if header and all(is_number(h) for h in header):
+        raise DataError(f"{str(p)!r}: expected a header row of column names first (a header row such as u,y), got numbers "
                         f"({delimiter.join(header[:4])}{', ...' if len(header) > 4 else ''})")
     if len(set(header)) != len(header):
         dup = sorted({h for h in header if header.count(h) > 1})
