@@ -188,24 +188,13 @@ def _report(error: BaseException) -> int:
         return EXIT_USAGE
 
 
-def entry() -> None:  # pragma: no cover - the console script, exercised in subprocess tests
-    """The ``hwpts`` console script: :func:`main` on ``sys.argv``, then exit with its status.
-
-    After an interrupt the process ends at once (``os._exit``, streams flushed): a signal that
-    landed inside a compiled library (LLVM compiling a numba kernel) can leave it in a state whose
-    teardown at interpreter exit crashes; every output and temporary file is already settled.
-    """
-    finish(main())
-
-
-def finish(status: int) -> None:  # pragma: no cover - the console script's exit
-    """Exit with ``status``; after an interrupt (130) at once (see :func:`entry`)."""
+def finish(status: int) -> None:  # pragma: no cover - the console script's exit (hwpts._console)
+    """Exit with ``status``. After an interrupt (130) the process ends at once (``os._exit``,
+    streams flushed): a signal that landed inside a compiled library (LLVM compiling a numba
+    kernel) can leave it in a state whose teardown at interpreter exit crashes; every output and
+    temporary file is already settled."""
     if status == 130:
         sys.stdout.flush()
         sys.stderr.flush()
         os._exit(130)
     sys.exit(status)
-
-
-if __name__ == "__main__":  # pragma: no cover
-    entry()

@@ -148,7 +148,11 @@ class IODataset:
             )
         n = len(columns[output_name])
         if time_name is not None and time_name in columns:
-            time = columns[time_name]
+            time = np.asarray(columns[time_name], dtype=float)
+            if not np.all(np.isfinite(time)):  # said here, where the column's name is known
+                bad = int(np.argmax(~np.isfinite(time)))
+                raise DataError(f"the time column {time_name!r} has a non-finite value (NaN, inf or an empty "
+                                f"cell) at row {bad}")
         else:
             time = np.arange(n) * float(sample_time)
         inputs = np.column_stack([np.asarray(columns[c], dtype=float) for c in input_names])

@@ -35,14 +35,12 @@ def cmd_residuals(args) -> int:
         print("the residuals are rounding errors (rms under 1e-9 of the output's standard deviation): the model "
               "reproduces the data exactly, and the whiteness and input-correlation tests, which assume a "
               "noise, do not apply")
-        if args.plot is not None:
-            print(f"wrote {args.plot}")
-        return 0
-    print(f"whiteness: {100 * share['autocorrelation']:.1f} % of lags 1..{args.lags} outside the {conf} band "
-          f"(+-{result['band']:.4g}) -> {'white' if result['white'] else 'NOT white'}")
-    for name, value in share["cross_correlation"].items():
-        print(f"input {name}: {100 * value:.1f} % of lags 0..{args.lags} outside the band -> "
-              f"{'uncorrelated' if value <= 0.05 else 'CORRELATED'}")
+    else:
+        print(f"whiteness: {100 * share['autocorrelation']:.1f} % of lags 1..{args.lags} outside the {conf} band "
+              f"(+-{result['band']:.4g}) -> {'white' if result['white'] else 'NOT white'}")
+        for name, value in share["cross_correlation"].items():
+            print(f"input {name}: {100 * value:.1f} % of lags 0..{args.lags} outside the band -> "
+                  f"{'uncorrelated' if value <= 0.05 else 'CORRELATED'}")
     if args.plot is not None:
         print(f"wrote {args.plot}")
     return 0

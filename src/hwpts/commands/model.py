@@ -90,10 +90,6 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
         where = f"no rows selected (--rows {rows})" if rows is not None else "the file holds no data rows"
         raise DataError(f"{str(path)!r}: {where}")
     tname = next((c for c in candidates if c in cols), None)
-    if tname is not None and not np.all(np.isfinite(np.asarray(cols[tname], dtype=float))):
-        bad = int(np.argmax(~np.isfinite(np.asarray(cols[tname], dtype=float))))
-        raise DataError(f"{str(path)!r}: the time column {tname!r} has a non-finite value (NaN, inf or an "
-                        f"empty cell) at row {bad}")
     detected = time_name is None and tname is not None
     hint = f" ({tname!r} is taken as the time column by its name; --time none uses the sample index)" if detected else ""
     timed = tname is not None
@@ -110,6 +106,11 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
     except DataError as error:
         raise DataError(f"{error}{hint}") from None
     return data, dt
+
+
+def _selection(args, name: str) -> str:
+    """The data file's name for a message, with the ``--rows`` selection when one was given."""
+    return name + (f" (--rows {args.rows})" if args.rows else "")
 
 
 def _sample_time(data, path, tname) -> float | None:
@@ -344,7 +345,7 @@ def cmd_identify(args) -> int:
     if not searched:
         structure = RegressorStructure.create(fixed["output_order"], fixed["input_order"], fixed["input_delay"],
                                               len(args.input), True, args.input, args.output)
-        structure.check_length(data.n_samples, what=f"{args.data!s}" + (f" (--rows {args.rows})" if args.rows else ""))
+        structure.check_length(data.n_samples, what=_selection(args, str(args.data)))
     hyperplanes = [Hyperplane.parse(h) for h in args.hyperplane]
     segmentation = args.segmentation
     if hyperplanes and segmentation is None:
@@ -527,7 +528,7 @@ def _model_and_data(args):
     _check_signals(inputs, output)
     data, dt = _load_dataset(args.data, inputs, output, args.time, args.rows)
     data = _check_sample_time(model, data, dt, args.data, args.resample)
-    st.check_length(data.n_samples, what=repr(str(args.data)) + (f" (--rows {args.rows})" if args.rows else ""))
+    st.check_length(data.n_samples, what=_selection(args, repr(str(args.data))))
     return model, data
 
 
