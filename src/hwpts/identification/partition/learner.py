@@ -7,7 +7,9 @@ every mode with ``cost_ik = r_ik^2 / sigma^2 - log p_i(x_k)`` (residual plus the
 confidence, which separates modes with equal parameters), and refits the classifier on the rows
 whose best mode wins by ``confidence_margin``. Ambiguous rows near a boundary carry no information
 about where it lies, so they are left to the classifier. Optionally (``sparse``) the columns the
-boundaries hardly use are dropped (:meth:`PartitionLearner.sparse_partition`).
+boundaries hardly use are dropped (:meth:`PartitionLearner.sparse_partition`). Last, a boundary
+that misclassifies some of its own training rows although they are separable is moved into the
+gap between them (:meth:`PartitionLearner.sharpen`).
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ from hwpts.identification.partition.polyhedra import fit_linear_partition
 __all__ = ["PartitionLearner", "drop_empty_regions", "noise_variance", "confident_rows", "TRIM"]
 
 TRIM = 3.0  # outlier threshold (robust std) of the local least squares of learned partitions
+SEPARABLE_C = 1e8  # the classifier's regularisation on labels it can separate exactly (sharpen)
 
 
 def drop_empty_regions(labels, s):
@@ -79,12 +82,16 @@ class PartitionLearner:
         A column whose boundary weight is below this share of the largest is dropped.
     trim : float
         Outlier threshold (robust standard deviations) of the local least squares.
+    separable_C : float or None
+        When the classifier's training rows can be separated exactly, the boundaries are refitted
+        with this (weak) regularisation, which puts them in the gaps between the regions' rows
+        (:meth:`sharpen`); ``None``: never.
     random_state : int or None
     """
 
     def __init__(self, *, refinement_rounds: int = 3, C: float = 1e4, ridge: float = 0.0, sparse: bool = True,
                  confidence_margin: float = 4.0, classifier_rows: int = 6000, sparse_tol: float = 0.05,
-                 trim: float = TRIM, random_state=None):
+                 trim: float = TRIM, separable_C=SEPARABLE_C, random_state=None):
         self.refinement_rounds = refinement_rounds
         self.C = C
         self.ridge = ridge
@@ -93,6 +100,7 @@ class PartitionLearner:
         self.classifier_rows = classifier_rows
         self.sparse_tol = sparse_tol
         self.trim = trim
+        self.separable_C = separable_C
         self.random_state = random_state
 
     def learn(self, X, y, labels, s, constant=True, columns=None, init=None):
@@ -137,6 +145,11 @@ class PartitionLearner:
             sparse = self.sparse_partition(train_X, train_labels, partition, s, columns)
             if sparse is not None:
                 partition, sparse_columns = sparse
+                labels = partition.predict(X)
+        if s > 1:
+            sharp = self.sharpen(train_X, train_labels, partition, s, columns if sparse_columns is None else sparse_columns)
+            if sharp is not partition:
+                partition = sharp
                 labels = partition.predict(X)
         # regions emptied by the last round or by the sparse classifier: refit on the ones left
         labels, s = drop_empty_regions(labels, s)
@@ -183,6 +196,30 @@ class PartitionLearner:
             if int(np.sum(reduced.predict(X) != labels)) <= errors_full + max(1, int(0.001 * labels.size)):
                 return reduced, np.flatnonzero(used)
         return None
+
+    def sharpen(self, X, labels, partition, s, columns=None):
+        """The classifier refitted with ``separable_C`` (warm-started from ``partition``) when
+        ``partition`` misclassifies some rows of ``X`` (its own training rows) and the refit
+        separates every one of them by its label; else ``partition`` itself.
+
+        On separable labels the regularised (``C``) logistic boundary can be pulled across rows by
+        the log-loss of the many rows near it; as the regularisation vanishes its direction tends
+        to the maximum-margin separator (Rosset, Zhu & Hastie 2004), midway in the gap. Measured: a
+        two-mode system switching on the sign of ``y(k-1)`` (2,000 samples) had its boundary at
+        ``y(k-1) = 7e-4`` with ``C = 1e4``, beyond a training row at 3e-5, and lost 5 points of
+        one-step fit to the validation samples in between (each costs the jump between the modes);
+        sharpened, 99.9 % (the true partition's). A boundary that already separates its rows is
+        kept: those rows are the confident ones, and the ambiguous rows left out open a gap wider
+        than the data's, whose middle is no better an estimate (sharpening there too lowered the
+        zoo's ``hit_cake`` from 75.2 to 73.6 % and ``hit_1d_3modes`` from 85.8 to 85.2 %; a weaker
+        ``C`` everywhere, 1e6 or 1e8, lowered them as much).
+        """
+        if self.separable_C is None or s < 2 or np.array_equal(partition.predict(X), labels):
+            return partition
+        sharp = fit_linear_partition(X, labels, s, C=self.separable_C, columns=columns, init=partition)
+        if np.array_equal(sharp.predict(X), labels):
+            return sharp
+        return partition
 
     def _subsample(self, labels, s, rng):
         """Indices of at most ``classifier_rows`` rows drawn at random, all rows of a small region kept."""
