@@ -6,7 +6,7 @@ Two questions the zoo and real-data benchmarks leave open, answered with numbers
    the oracle of the zoo knows the true partition at validation time. Here every training
    sample's true mode and the oracle's parameters are given, and only the partition is learned
    from the labelled training samples, by three classifiers of different kinds: hwpts's
-   multinomial logistic classifier (``fit_linear_partition``, what the library uses), pairwise
+   multinomial logistic classifier (``fit_linear_partition`` and ``PartitionLearner.sharpen``, what the library uses), pairwise
    linear SVMs voting one against one (a max-margin boundary per pair of modes), and the nearest
    training sample (no linear boundary at all). Whatever the classifier, a validation sample that
    falls between the last training sample of one mode and the first of another can land on either
@@ -61,8 +61,7 @@ def boundary_limits(zoo, names, seeds):
     from sklearn.neighbors import KNeighborsClassifier
     from sklearn.preprocessing import StandardScaler
 
-    from benchmarks.bench_zoo import one_step_fit, oracle_theta, validation_n
-    from hwpts.identification.partition import fit_linear_partition
+    from benchmarks.bench_zoo import learned_partition, one_step_fit, oracle_theta, validation_n
 
     out = {}
     for name in names:
@@ -85,7 +84,7 @@ def boundary_limits(zoo, names, seeds):
                 warnings.simplefilter("ignore")
                 labels = {
                     "oracle": d.region_fn(Phi_v),
-                    "logistic": fit_linear_partition(Phi, M, d.n_modes).predict(Phi_v),
+                    "logistic": learned_partition(Phi, M, d.n_modes).predict(Phi_v),
                     "svm": _pairwise_svm(Z, M, Zv, d.n_modes),
                     "nearest": KNeighborsClassifier(1).fit(Z, M).predict(Zv),
                 }

@@ -107,6 +107,16 @@ def oracle_theta(zoo, d):
     return theta
 
 
+def learned_partition(Phi, modes, s):
+    """The library's region classifier of the labelled rows ``Phi`` (modes ``0 .. s-1``), as a
+    learned partition ends: the logistic classifier, sharpened when it misclassifies some of its
+    rows although they are separable (``PartitionLearner.sharpen``)."""
+    from hwpts.identification.partition import PartitionLearner, fit_linear_partition
+
+    part = fit_linear_partition(Phi, modes, s)
+    return PartitionLearner().sharpen(Phi, modes, part, s)
+
+
 def one_step_fit(y, yhat):
     return 100.0 * (1.0 - np.linalg.norm(y - yhat) / np.linalg.norm(y - y.mean()))
 
@@ -149,9 +159,7 @@ def run_system(zoo, name, seeds, pyparc_py, progress=None, kw=None):
         if d.theta is not None:
             Phi, Y, M = d.regressors()
             okm = M >= 0
-            from hwpts.identification.partition import fit_linear_partition
-
-            part = fit_linear_partition(Phi[okm], M[okm], d.n_modes)
+            part = learned_partition(Phi[okm], M[okm], d.n_modes)
             reg = part.predict(Phi_v)
             yhat = np.einsum("ij,ij->i", np.column_stack([Phi_v, np.ones(len(Phi_v))]), th[reg])
             rows["modes"]["onestep"].append(one_step_fit(Y_v[ok_v], yhat[ok_v]))
