@@ -77,7 +77,9 @@ class PWARX(BaseEstimator):
     refinement_rounds : int
         Boundary refinement rounds for learned partitions.
     classifier_C : float
-        Inverse regularisation of the multinomial logistic region classifier.
+        Inverse regularisation of the multinomial logistic region classifier (a learned partition
+        whose classifier misclassifies some of its separable training rows is refitted with a
+        vanishing one: :meth:`~hwpts.identification.partition.PartitionLearner.sharpen`).
     segmentation_params : dict, optional
         Keyword parameters of the segmentation method.
     partition_columns : sequence of str, optional

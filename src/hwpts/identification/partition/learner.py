@@ -83,9 +83,9 @@ class PartitionLearner:
     trim : float
         Outlier threshold (robust standard deviations) of the local least squares.
     separable_C : float or None
-        When the classifier's training rows can be separated exactly, the boundaries are refitted
-        with this (weak) regularisation, which puts them in the gaps between the regions' rows
-        (:meth:`sharpen`); ``None``: never.
+        When the regularised classifier misclassifies some of its training rows and they can be
+        separated exactly, the boundaries are refitted with this (weak) regularisation, which puts
+        them in the gaps between the regions' rows (:meth:`sharpen`); ``None``: never.
     random_state : int or None
     """
 
