@@ -146,15 +146,13 @@ class PartitionLearner:
             if sparse is not None:
                 partition, sparse_columns = sparse
                 labels = partition.predict(X)
-        if s > 1:
-            sharp = self.sharpen(train_X, train_labels, partition, s, columns if sparse_columns is None else sparse_columns)
-            if sharp is not partition:
-                partition = sharp
-                labels = partition.predict(X)
+        cols = columns if sparse_columns is None else sparse_columns
+        sharp = self.sharpen(train_X, train_labels, partition, s, cols)
+        if sharp is not partition:
+            partition, labels = sharp, sharp.predict(X)
         # regions emptied by the last round or by the sparse classifier: refit on the ones left
         labels, s = drop_empty_regions(labels, s)
         if partition.n_regions != s:
-            cols = columns if sparse_columns is None else sparse_columns
             partition = fit_linear_partition(X, labels, s, C=self.C, columns=cols)
             labels = partition.predict(X)
             if s == 1:
