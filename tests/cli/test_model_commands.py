@@ -222,6 +222,30 @@ def test_identify_chooses_the_orders_and_says_why(tmp_path, capsys):
     assert "held-out blocks" in choice["why"] and choice["n_candidates"] == len(summary["candidates"]) == 40
     assert sum(bool(r.get("chosen")) for r in summary["candidates"]) == 1
     assert choice["scoring"] == "free-run" and "one-step" not in choice["why"]
+    assert choice["orders"] is None  # one method and count: the grid of orders ranks itself
+
+
+def test_identify_says_how_it_ranked_the_orders(tmp_path, capsys):
+    """Three modes behind oblique boundaries: no ARX model explains them, a nearest-neighbour
+    predictor does, and the orders it predicts best with (the true 1/1/1) are chosen; the summary
+    says so."""
+    rng = np.random.default_rng(0)
+    n = 1000
+    u = rng.uniform(-2, 2, n)
+    y = np.zeros(n)
+    theta = np.array([[0.5, 1.0, 0.0], [0.8, -0.5, 0.3], [0.2, 0.7, -0.4]])
+    for k in range(1, n):
+        mode = 0 if y[k - 1] + u[k - 1] < -0.5 else (1 if y[k - 1] - u[k - 1] < 0.5 else 2)
+        y[k] = theta[mode] @ [y[k - 1], u[k - 1], 1.0] + 0.05 * rng.standard_normal()
+    path = tmp_path / "oblique.csv"
+    write_csv(path, {"u": u, "y": y})
+    out = tmp_path / "m.json"
+    assert main(["identify", str(path), "--input", "u", "--output", "y", "--out", str(out)]) == 0
+    choice = json.loads(capsys.readouterr().out)["choice"]
+    orders = choice["orders"]
+    assert orders["ranked_by"] == "neighbours" and orders["neighbour_one_step_percent"] > orders["arx_one_step_percent"] + 10
+    assert "no ARX model explains the data" in orders["why"]
+    assert (choice["na"], choice["nb"], choice["nk"]) == (1, [1], [1])
 
 
 def test_identify_scoring(tmp_path, capsys):

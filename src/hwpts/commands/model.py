@@ -206,6 +206,7 @@ def _fit_summary(model, data, path, out, elapsed, search=None):
             "n_candidates": len(table), "n_blocks": search.n_splits_,
             "scoring": search.scoring_.replace("_", "-"),
             "shared_modes": _modes_gate_summary(search),
+            "orders": _orders_summary(search),
             "why": (f"best mean {'one-step' if search.scoring_ == 'one_step' else 'free-run'} fit over "
                     f"{search.n_splits_} held-out blocks of the training data "
                     f"({len(table)} candidates; within {search.tolerance} points the fewest regions, then the "
@@ -216,6 +217,27 @@ def _fit_summary(model, data, path, out, elapsed, search=None):
         summary["candidates"] = table
     summary["fit_time_s"] = round(elapsed, 3)
     return summary
+
+
+def _orders_summary(search):
+    """The summary's account of how the orders carried to the region stage were ranked (``None``
+    when the orders were given)."""
+    from hwpts.identification.selection.search import NEIGHBOUR_GATE
+
+    info = getattr(search, "orders_ranking_", None)
+    if not info:
+        return None
+    arx, nn = info["arx_one_step_percent"], info["neighbour_one_step_percent"]
+    if info["ranked_by"] == "neighbours":
+        why = (f"a nearest-neighbour predictor's held-out one-step fit ({nn:.1f} %) beat every ARX model's "
+               f"({arx:.1f} %) by more than {NEIGHBOUR_GATE:g} points: no ARX model explains the data, so the "
+               f"orders the neighbours predict best with were tried beside the ARX models' best")
+    elif nn is None:
+        why = f"the orders of the best ARX models (held-out one-step fit {arx:.1f} %) were tried"
+    else:
+        why = (f"the orders of the best ARX models were tried (held-out one-step fit {arx:.1f} %; a "
+               f"nearest-neighbour predictor's {nn:.1f} % was not {NEIGHBOUR_GATE:g} points better)")
+    return {**info, "why": why}
 
 
 def _modes_gate_summary(search):

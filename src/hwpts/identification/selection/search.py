@@ -96,6 +96,11 @@ FREE_RUN_FLOOR = 10.0
 # 17, 14, 12 % at 2-6 models against the candidates' 50 %, which opened the first rule at 6 models
 # for 5 s of candidates that lost): hence the quarter, and the halving from K - 1 to K
 MODES_GATE = (0.25, 10.0, 0.5)
+# the orders are ranked by a nearest-neighbour predictor's held-out one-step fit (selection/orders.py)
+# instead of the ARX models' where it beats the best ARX model's by this many points. Measured (best
+# neighbours / best ARX, held-out one-step %): oblique_3 ~83 / ~24 (every ARX order within 0.1 point:
+# a ranking by noise); the four real records 54-99.9 / 93-99.99, where the ARX ranking stands
+NEIGHBOUR_GATE = 10.0
 SCORINGS = ("auto", "free_run", "one_step")
 # "trailing" (:func:`_behind`): 2 points of free-run fit AND 20 % more one-step misfit (100 - fit)
 # than the leader. A candidate trailing the best complete candidate on the same first blocks is not
@@ -241,6 +246,12 @@ class PWARXSearch(BaseEstimator):
         the estimator's value).
     n_orders : int
         Orders carried from the ARX stage to the region stage.
+    order_ranking : {"neighbours", "arx"}
+        How the carried orders are ranked: ``"arx"``, by the single ARX models' held-out fits;
+        ``"neighbours"`` (default), the same unless a nearest-neighbour predictor's held-out
+        one-step fit beats every ARX model's by :data:`NEIGHBOUR_GATE` points (the data are far
+        from linear and the ARX ranking is noise): then the neighbours' best orders and the ARX
+        models' best are carried in turn (:mod:`hwpts.identification.selection.orders`).
     max_regions : int or "auto"
         Largest number of regions tried ("auto": 10, more while the held-out free-run fit keeps
         rising, at most 40, and while the training rows hold ``3 p`` rows a region for ``p``
@@ -281,6 +292,9 @@ class PWARXSearch(BaseEstimator):
         Its mean held-out fit % (free run or one-step, as ``scoring_`` says).
     scoring_ : str
         What ranked the candidates: ``"free_run"`` or ``"one_step"``.
+    orders_ranking_ : dict or None
+        How the carried orders were ranked (``ranked_by``: ``"arx"`` or ``"neighbours"``, with the
+        best held-out one-step fits of both); ``None`` when the orders were not searched.
     modes_gate_ : dict or None
         The shared-modes gate (``open``, the ``modes`` it opened at, the in-sample
         ``switched_fits_percent`` by number of modes, the ``best_one_step`` held-out fit it was
@@ -309,7 +323,7 @@ class PWARXSearch(BaseEstimator):
     def __init__(self, estimator=None, param_grid=None, *, cv=None, methods=DEFAULT_METHODS, orders=None,
                  n_orders: int = 3, max_regions="auto", patience: int = 2, tolerance: float = 0.5,
                  try_polish="auto", refit_margin: float = 5.0, n_jobs=None, progress: bool = False,
-                 scoring: str = "auto", shared_modes="auto"):
+                 scoring: str = "auto", shared_modes="auto", order_ranking: str = "neighbours"):
         self.estimator = estimator
         self.param_grid = param_grid
         self.cv = cv
@@ -325,6 +339,7 @@ class PWARXSearch(BaseEstimator):
         self.progress = progress
         self.scoring = scoring
         self.shared_modes = shared_modes
+        self.order_ranking = order_ranking
 
     # ------------------------------------------------------------------ helpers
     def _base(self):
@@ -447,7 +462,10 @@ class PWARXSearch(BaseEstimator):
         self.scoring_ = "one_step" if self.scoring == "one_step" else "free_run"
         if self.shared_modes not in (True, False, "auto"):
             raise ParameterError(f"PWARXSearch: shared_modes must be True, False or 'auto', got {self.shared_modes!r}")
+        if self.order_ranking not in ("neighbours", "arx"):
+            raise ParameterError(f"PWARXSearch: order_ranking must be 'neighbours' or 'arx', got {self.order_ranking!r}")
         self.modes_gate_ = None
+        self.orders_ranking_ = None
         order_grid = self._order_grid(base)
         max_lag = max(self._max_lag(base, o) for o in order_grid)
         splits = self._splits(n, max_lag)
@@ -506,7 +524,8 @@ class PWARXSearch(BaseEstimator):
             self._decide_scoring(rows)
             ranked = sorted(rows, key=lambda r: -self._score(r))
             keep = [{k: r["params"][k] for k in ORDER_KEYS if k in r["params"]} for r in ranked
-                    if np.isfinite(self._score(r))][: max(1, int(self.n_orders))]
+                    if np.isfinite(self._score(r))]
+            keep = self._carried_orders(base, keep, rows, u, y, splits)
             if not keep:
                 errors = sorted({r["error"] for r in rows if r["error"]})
                 if len(errors) == 1 and all(r["error"] for r in rows):  # one cause, whatever the order
@@ -573,6 +592,39 @@ class PWARXSearch(BaseEstimator):
                 survivors = active
         table.extend(self._modes_stage(base, table, u, y, splits, bar))
         return table
+
+    def _carried_orders(self, base, by_arx, arx_rows, u, y, splits) -> list[dict]:
+        """The ``n_orders`` orders carried to the region stage: the ARX ranking's best (``by_arx``),
+        or, where a nearest-neighbour predictor's held-out one-step fit beats every ARX model's by
+        :data:`NEIGHBOUR_GATE` points (no ARX model explains the data, so their ranking is noise),
+        the neighbours' best and the ARX ranking's best in turn (:mod:`.orders`)."""
+        from hwpts.identification.selection.orders import neighbour_fits
+
+        count = max(1, int(self.n_orders))
+        arx_one = max((r["mean_one_step_fit_percent"] for r in arx_rows
+                       if r["mean_one_step_fit_percent"] is not None), default=-np.inf)
+        info = {"ranked_by": "arx", "arx_one_step_percent": round(float(arx_one), 3)
+                if np.isfinite(arx_one) else None, "neighbour_one_step_percent": None}
+        # no predictor can beat an ARX model's fit above 100 - NEIGHBOUR_GATE by the gate: not
+        # computed there (the four real records: 90.1-100 %)
+        if self.order_ranking == "neighbours" and by_arx and arx_one < 100.0 - NEIGHBOUR_GATE:
+            grid = [dict(r["params"]) for r in arx_rows]
+            seed = base.random_state if isinstance(base.random_state, (int, np.integer)) else 0
+            fits = neighbour_fits(u, y, [self._orders_of(base, o) for o in grid], splits, random_state=seed)
+            finite = [(f, i) for i, f in enumerate(fits) if np.isfinite(f)]
+            if finite:
+                best_nn = max(f for f, _ in finite)
+                info["neighbour_one_step_percent"] = round(best_nn, 3)
+                if best_nn > arx_one + NEIGHBOUR_GATE:
+                    info["ranked_by"] = "neighbours"
+                    by_nn = [{k: grid[i][k] for k in ORDER_KEYS if k in grid[i]}
+                             for _, i in sorted(finite, key=lambda fi: (-fi[0], fi[1]))]
+                    merged = []
+                    for pair in itertools.zip_longest(by_nn, by_arx):
+                        merged.extend(o for o in pair if o is not None and o not in merged)
+                    by_arx = merged
+        self.orders_ranking_ = info
+        return by_arx[:count]
 
     def _modes_stage(self, base, table, u, y, splits, bar):
         """Rows of the ``switched`` segmentation (modes first, then their regions) on the leader's
