@@ -423,3 +423,29 @@ def test_identify_reports_a_cascade_of_region_warnings_in_one_line():
     ]
     assert _warning_lines(caught(dropped(5, 4))) == [str(dropped(5, 4))]  # one: as it was said
     assert _warning_lines(caught(dropped(5, 4), dropped(3, 2))) == [str(dropped(5, 4)), str(dropped(3, 2))]
+
+
+def test_identify_estimates_a_dead_time_when_nk_is_not_given(tmp_path, capsys):
+    """Without --nk (and without both --na and --nb, which default --nk to 1) the delay is estimated
+    (as MATLAB's delayest): a 5-sample dead time, beyond the grid's delays 0 and 1, is found and
+    said; with --nk given nothing is estimated."""
+    rng = np.random.default_rng(0)
+    n = 1200
+    u = rng.uniform(-1, 1, n)
+    y = np.zeros(n)
+    for k in range(7, n):
+        drive = 0.6 * u[k - 5] + 0.3 * u[k - 6]
+        y[k] = (1.2 * y[k - 1] - 0.5 * y[k - 2] + drive if y[k - 1] > 0
+                else 0.9 * y[k - 1] - 0.3 * y[k - 2] + 0.4 * drive + 0.1) + 0.02 * rng.standard_normal()
+    path = tmp_path / "dead_time.csv"
+    write_csv(path, {"u": u, "y": y})
+    out = tmp_path / "m.json"
+    base = ["identify", str(path), "--input", "u", "--output", "y", "--nb", "2", "--regions", "2",
+            "--out", str(out)]
+    assert main(base) == 0
+    choice = json.loads(capsys.readouterr().out)["choice"]
+    assert choice["input_delays"]["estimated"] == [5] and choice["input_delays"]["tried"] == [5, 4]
+    assert "dead time" in choice["input_delays"]["why"] and choice["nk"] == [5]
+    out.unlink()
+    assert main(base + ["--nk", "1"]) == 0
+    assert json.loads(capsys.readouterr().out)["choice"]["input_delays"] is None

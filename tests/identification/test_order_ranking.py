@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 
 from hwpts.errors import ParameterError
 from hwpts.identification import PWARX, PWARXSearch
-from hwpts.identification.selection.orders import _inside, neighbour_fits
+from hwpts.identification.selection.orders import _inside, delay_candidates, estimate_delays, neighbour_fits
 from hwpts.identification.selection.splitters import BlockedSplit
 
 SMALL_GRID = {"output_order": [1, 2, 3], "input_order": [1, 2, 3], "input_delay": [1]}
@@ -95,3 +95,55 @@ def test_order_ranking_is_checked(bad):
     u, y = linear(300, 2)
     with pytest.raises(ParameterError, match="order_ranking"):
         PWARXSearch(PWARX(2, 1, 1), order_ranking=bad).fit(u, y)
+
+
+def dead_time(n, seed, delays, sigma=0.02):
+    """Two modes switching on the sign of y(k-1), each input acting through its own dead time
+    (``delays`` per input: u_j(k - d_j) and u_j(k - d_j - 1))."""
+    rng = np.random.default_rng(seed)
+    u = rng.uniform(-1, 1, (n, len(delays)))
+    y = np.zeros(n)
+    for k in range(max(delays) + 2, n):
+        drive = sum(0.6 * u[k - d, j] + 0.3 * u[k - d - 1, j] for j, d in enumerate(delays))
+        y[k] = (1.2 * y[k - 1] - 0.5 * y[k - 2] + drive if y[k - 1] > 0
+                else 0.9 * y[k - 1] - 0.3 * y[k - 2] + 0.4 * drive + 0.1) + sigma * rng.standard_normal()
+    return u, y
+
+
+@pytest.mark.parametrize("delays", [(3,), (5,), (8,), (0, 6)])
+def test_the_dead_time_of_each_input_is_estimated(delays):
+    u, y = dead_time(1500, 0, delays)
+    assert estimate_delays(u, y) == delays
+
+
+def test_delays_of_the_grid_are_kept_without_evidence_of_dead_time():
+    u, y = dead_time(1500, 1, (1,))
+    assert estimate_delays(u, y) in ((0,), (1,))
+    assert delay_candidates(estimate_delays(u, y)) == [1, 0]
+    # an input that does not move the output: flat losses, no delay read into them
+    rng = np.random.default_rng(2)
+    y = np.convolve(rng.standard_normal(1500), [1, 0.5, 0.2], mode="same")
+    assert estimate_delays(rng.uniform(-1, 1, (1500, 2)), y)[0] <= 1
+    assert estimate_delays(np.ones((20, 1)), np.arange(20.0)) == (0,)  # too short to try any: none
+
+
+def test_delay_candidates_are_the_estimate_and_one_less():
+    assert delay_candidates([0]) == delay_candidates([1, 0]) == [1, 0]
+    assert delay_candidates([5]) == delay_candidates([5, 5]) == [5, 4]
+    assert delay_candidates([0, 6]) == [[0, 6], [0, 5]]
+
+
+def test_the_search_finds_a_dead_time_the_orders_grid_does_not_reach():
+    u, y = dead_time(1500, 3, (5,))
+    grid = {"output_order": [2], "input_order": [2], "input_delay": "auto"}
+    search = PWARXSearch(PWARX(random_state=0), orders=grid, max_regions=2, try_polish=False).fit(u, y)
+    assert search.input_delays_ == (5,)
+    assert {r["params"]["input_delay"] for r in search.cv_results_} == {5, 4}
+    assert search.best_estimator_.structure_.nk == (5,)
+    # told only the grid's delays 0 and 1, no model sees u(k-5): the fit is far lower
+    short = PWARXSearch(PWARX(random_state=0), orders={**grid, "input_delay": [1, 0]}, max_regions=2,
+                        try_polish=False).fit(u, y)
+    assert short.input_delays_ is None
+    assert search.best_score_ > short.best_score_ + 20
+    with pytest.raises(ParameterError, match="input_delay"):
+        PWARXSearch(PWARX(), orders={**grid, "input_delay": "guess"}).fit(u, y)

@@ -179,7 +179,7 @@ def _units(names, given) -> dict:
     return units
 
 
-def _fit_summary(model, data, path, out, elapsed, search=None):
+def _fit_summary(model, data, path, out, elapsed, search=None, delays=None):
     from hwpts.identification.metrics import fit_percent, rmse
     from hwpts.identification.selection.search import FREE_RUN_FLOOR
 
@@ -207,6 +207,7 @@ def _fit_summary(model, data, path, out, elapsed, search=None):
             "scoring": search.scoring_.replace("_", "-"),
             "shared_modes": _modes_gate_summary(search),
             "orders": _orders_summary(search),
+            "input_delays": _delays_summary(delays),
             "why": (f"best mean {'one-step' if search.scoring_ == 'one_step' else 'free-run'} fit over "
                     f"{search.n_splits_} held-out blocks of the training data "
                     f"({len(table)} candidates; within {search.tolerance} points the fewest regions, then the "
@@ -217,6 +218,19 @@ def _fit_summary(model, data, path, out, elapsed, search=None):
         summary["candidates"] = table
     summary["fit_time_s"] = round(elapsed, 3)
     return summary
+
+
+def _delays_summary(delays):
+    """The summary's account of the input delays searched (``None`` when ``--nk`` was given)."""
+    from hwpts.identification.selection.orders import DELAY_TOLERANCE, MAX_DELAY, delay_candidates
+
+    if delays is None:
+        return None
+    tried = delay_candidates(delays)
+    why = (f"delays {tried} tried: an ARX model with each delay 0..{MAX_DELAY} (as MATLAB's delayest) "
+           + ("found none above 1 that cut the loss of delays 0 and 1 by "
+              f"{100 * DELAY_TOLERANCE:g} %" if max(delays) <= 1 else "found the dead time " + str(list(delays))))
+    return {"estimated": list(delays), "tried": tried, "why": why}
 
 
 def _orders_summary(search):
@@ -364,6 +378,12 @@ def cmd_identify(args) -> int:
                              f"region{'s' if count > 1 else ''}; leave --regions out or choose another method")
     data, dt = _load_dataset(args.data, args.input, args.output, args.time, args.rows)
     units = _units([*args.input, args.output], args.unit)
+    delays = None
+    if "input_delay" in searched:  # the delays 0 and 1 of the grid, or the dead time the data show
+        from hwpts.identification.selection.orders import delay_candidates, estimate_delays
+
+        delays = estimate_delays(data.inputs, data.output)
+        searched["input_delay"] = delay_candidates(delays)
     if not searched:
         structure = RegressorStructure.create(fixed["output_order"], fixed["input_order"], fixed["input_delay"],
                                               len(args.input), True, args.input, args.output)
@@ -449,7 +469,7 @@ def cmd_identify(args) -> int:
             model.fit(data.inputs, data.output, input_names=args.input, output_name=args.output,
                       sample_time=dt, units=units)
     elapsed = time.perf_counter() - t0
-    summary = _fit_summary(model, data, args.data, args.out, elapsed, search)
+    summary = _fit_summary(model, data, args.data, args.out, elapsed, search, delays)
     notes = _warning_lines([w.message for w in caught if issubclass(w.category, UserWarning)])
     if notes:
         summary["warnings"] = notes

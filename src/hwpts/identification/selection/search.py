@@ -241,9 +241,12 @@ class PWARXSearch(BaseEstimator):
     methods : sequence of str
         Segmentation methods of the adaptive search.
     orders : None, "auto" or dict
-        ``None``: the estimator's orders; ``"auto"``: searched over :data:`ORDER_GRID`; a dict
-        ``{"output_order": [...], "input_order": [...], "input_delay": [...]}`` (missing keys keep
-        the estimator's value).
+        ``None``: the estimator's orders; ``"auto"``: searched over :data:`ORDER_GRID`, its delays
+        (0 and 1) replaced by the estimated delay and one less where an input's delay is estimated
+        above 1 (:func:`~hwpts.identification.selection.orders.estimate_delays`, as MATLAB's
+        ``delayest``); a dict ``{"output_order": [...], "input_order": [...], "input_delay": [...]}``
+        (missing keys keep the estimator's value; ``"input_delay": "auto"`` estimates the delays
+        as ``"auto"`` does; a candidate may be a list, one value per input).
     n_orders : int
         Orders carried from the ARX stage to the region stage.
     order_ranking : {"neighbours", "arx"}
@@ -292,6 +295,8 @@ class PWARXSearch(BaseEstimator):
         Its mean held-out fit % (free run or one-step, as ``scoring_`` says).
     scoring_ : str
         What ranked the candidates: ``"free_run"`` or ``"one_step"``.
+    input_delays_ : tuple of int or None
+        The delays estimated per input when the delays were searched as ``"auto"``, else ``None``.
     orders_ranking_ : dict or None
         How the carried orders were ranked (``ranked_by``: ``"arx"`` or ``"neighbours"``, with the
         best held-out one-step fits of both); ``None`` when the orders were not searched.
@@ -347,21 +352,36 @@ class PWARXSearch(BaseEstimator):
 
         return clone(self.estimator) if self.estimator is not None else PWARX()
 
-    def _order_grid(self, base) -> list[dict]:
+    def _order_grid(self, base, u, y) -> list[dict]:
         if self.orders is None:
             return [{}]
         if self.orders == "auto":
-            grid = dict(ORDER_GRID)
+            grid = {**ORDER_GRID, "input_delay": "auto"}
         elif isinstance(self.orders, dict):
             unknown = set(self.orders) - set(ORDER_KEYS)
             if unknown:
                 raise ParameterError(f"PWARXSearch: orders has unknown keys {sorted(unknown)}; valid are {list(ORDER_KEYS)}")
-            grid = {k: tuple(v) for k, v in self.orders.items()}
+            grid = {k: v if isinstance(v, str) else tuple(v) for k, v in self.orders.items()}
         else:
             raise ParameterError(f"PWARXSearch: orders must be None, 'auto' or a dict of lists, got {self.orders!r}")
+        if isinstance(grid.get("input_delay"), str):
+            if grid["input_delay"] != "auto":
+                raise ParameterError(f"PWARXSearch: orders['input_delay'] must be 'auto' or a list, "
+                                     f"got {grid['input_delay']!r}")
+            from hwpts.identification.selection.orders import delay_candidates, estimate_delays
+
+            self.input_delays_ = estimate_delays(u, y)
+            grid["input_delay"] = tuple(delay_candidates(self.input_delays_))
+
+        def order_ok(v):
+            if isinstance(v, (list, tuple)):  # one per input
+                return len(v) > 0 and all(order_ok(x) for x in v)
+            return not isinstance(v, bool) and isinstance(v, (int, np.integer)) and v >= 0
+
         for key, values in grid.items():
-            if not values or any(isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 0 for v in values):
-                raise ParameterError(f"PWARXSearch: orders[{key!r}] must be non-empty ints >= 0, got {values!r}")
+            if isinstance(values, str) or not values or not all(order_ok(v) for v in values):
+                raise ParameterError(f"PWARXSearch: orders[{key!r}] must be non-empty ints >= 0 (or lists of them, "
+                                     f"one per input), got {values!r}")
         return expand_grid(grid)
 
     def n_training_rows(self, n_samples: int, max_lag: int = 0) -> int:
@@ -466,7 +486,8 @@ class PWARXSearch(BaseEstimator):
             raise ParameterError(f"PWARXSearch: order_ranking must be 'neighbours' or 'arx', got {self.order_ranking!r}")
         self.modes_gate_ = None
         self.orders_ranking_ = None
-        order_grid = self._order_grid(base)
+        self.input_delays_ = None
+        order_grid = self._order_grid(base, u, yy)
         max_lag = max(self._max_lag(base, o) for o in order_grid)
         splits = self._splits(n, max_lag)
         self.n_splits_ = len(splits)
