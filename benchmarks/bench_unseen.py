@@ -1,5 +1,6 @@
 """Systems the default search was never tuned on: five PWARX systems written for this check, none
-of them in the zoo, the real data or the tests.
+of them in the zoo, the real data or the tests (and a sixth, ``dead_time_5``, added later with the
+capability it checks).
 
 | system | what makes it hard |
 |---|---|
@@ -8,6 +9,7 @@ of them in the zoo, the real data or the tests.
 | ``oblique_3`` | three modes behind two oblique boundaries; one mode holds about 1 % of the rows |
 | ``slow_pole_sat`` | a slow pole (0.95) and a saturated input: three modes, steps held 20 samples |
 | ``oe_two_mode`` | two modes switching on ``y(k-1)``, with *output-error* noise (not equation error) |
+| ``dead_time_5`` | two modes switching on ``y(k-1)``, the input acting after a dead time of 5 samples (added with the delay estimate it checks: the orders grid's delays are 0 and 1) |
 
 Each seed: 2,000 training samples with noise of 5 % of the noise-free output's standard deviation
 (equation error, except ``oe_two_mode``), 3,000 noise-free validation samples from another input
@@ -60,6 +62,9 @@ SYSTEMS = {
     "oe_two_mode": _system(2, 1, 1, 1, [[1.2, -0.5, 1.0, 0.0], [0.9, -0.3, 0.3, 0.2]],
                            lambda p: 0 if p[0] > 0 else 1, lambda r, n: r.uniform(-1, 1, (n, 1)),
                            output_error=True),
+    # added with the delay estimate it checks (not unseen by it): a dead time of 5 samples
+    "dead_time_5": _system(2, 2, 5, 1, [[1.2, -0.5, 0.6, 0.3, 0.0], [0.9, -0.3, 0.25, 0.1, 0.1]],
+                           lambda p: 0 if p[0] > 0 else 1, lambda r, n: _held(r, n, -1, 1, 3)),
 }
 
 
