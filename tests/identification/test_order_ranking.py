@@ -147,3 +147,18 @@ def test_the_search_finds_a_dead_time_the_orders_grid_does_not_reach():
     assert search.best_score_ > short.best_score_ + 20
     with pytest.raises(ParameterError, match="input_delay"):
         PWARXSearch(PWARX(), orders={**grid, "input_delay": "guess"}).fit(u, y)
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 10_000), k=st.integers(1, 7), dims=st.integers(1, 6))
+def test_the_neighbour_prediction_is_scikit_learns_distance_weighted_one(seed, k, dims):
+    from sklearn.neighbors import KNeighborsRegressor
+
+    from hwpts.identification.selection.orders import _predict
+
+    rng = np.random.default_rng(seed)
+    X = rng.standard_normal((60, dims))
+    t = rng.standard_normal(60)
+    Xq = np.vstack([rng.standard_normal((20, dims)), X[:3]])  # the last three are exact matches
+    expected = KNeighborsRegressor(n_neighbors=k, weights="distance").fit(X, t).predict(Xq)
+    np.testing.assert_allclose(_predict(X, t, Xq, k), expected, rtol=1e-12, atol=1e-12)
