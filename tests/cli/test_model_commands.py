@@ -449,3 +449,7 @@ def test_identify_estimates_a_dead_time_when_nk_is_not_given(tmp_path, capsys):
     out.unlink()
     assert main(base + ["--nk", "1"]) == 0
     assert json.loads(capsys.readouterr().out)["choice"]["input_delays"] is None
+    out.unlink()
+    # a partition column among the lags of the estimated delay is a valid name (checked after it)
+    assert main(base + ["--partition-column", "u(k-6)"]) == 0
+    assert json.loads(capsys.readouterr().out)["choice"]["nk"] in ([5], [4])

@@ -346,7 +346,7 @@ def _check_partition_columns(args, fixed, searched) -> None:
         return
     na = fixed.get("output_order", max(searched.get("output_order", [0])))
     nb = fixed.get("input_order", max(searched.get("input_order", [1])))
-    delays = [fixed["input_delay"]] if "input_delay" in fixed else sorted(set(searched.get("input_delay", [1])))
+    delays = [fixed["input_delay"]] if "input_delay" in fixed else list(searched.get("input_delay", [1]))
     names = []
     for nk in delays:
         structure = RegressorStructure.create(na, nb, nk, len(args.input), True, args.input, args.output)
@@ -370,7 +370,6 @@ def cmd_identify(args) -> int:
 
     _check_signals(args.input, args.output)
     fixed, searched = _orders_to_search(args)
-    _check_partition_columns(args, fixed, searched)
     count = getattr(SEGMENTATION_METHODS.get(args.segmentation), "fixed_regions", None)
     if count is not None and args.regions != "auto" and str(args.regions).strip() != str(count):
         # a method that makes its own regions: --regions must agree or be left out
@@ -384,6 +383,7 @@ def cmd_identify(args) -> int:
 
         delays = estimate_delays(data.inputs, data.output)
         searched["input_delay"] = delay_candidates(delays)
+    _check_partition_columns(args, fixed, searched)  # after the delays: "u(k-5)" names a column then
     if not searched:
         structure = RegressorStructure.create(fixed["output_order"], fixed["input_order"], fixed["input_delay"],
                                               len(args.input), True, args.input, args.output)
