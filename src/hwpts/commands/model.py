@@ -227,8 +227,9 @@ def _delays_summary(delays):
     if delays is None:
         return None
     tried = delay_candidates(delays)
-    why = (f"delays {tried} tried: an ARX model with each delay 0..{MAX_DELAY} (as MATLAB's delayest) "
-           + ("found none above 1 that cut the loss of delays 0 and 1 by "
+    why = (f"delays {tried} tried: an ARX model with each delay from 0 up to {MAX_DELAY} (or a tenth of the "
+           f"record; as MATLAB's delayest) "
+           + ("found none above 1 that cut the loss of delays 0 and 1 by at least "
               f"{100 * DELAY_TOLERANCE:g} %" if max(delays) <= 1 else "found the dead time " + str(list(delays))))
     return {"estimated": list(delays), "tried": tried, "why": why}
 
@@ -718,7 +719,8 @@ def register(subparsers):
     p.add_argument("--nb", default=None, metavar="N",
                    help="input order, an int or one per input: 4,4 (default: chosen on the data, 1-4)")
     p.add_argument("--nk", default=None, metavar="N",
-                   help="input delay, 0 uses u(k) (default: chosen on the data, 0-1; 1 when --na and --nb are given)")
+                   help="input delay, 0 uses u(k) (default: chosen on the data, 0-1 or an estimated dead time "
+                        "and one less; 1 when --na and --nb are given)")
     p.add_argument("--segmentation", choices=["auto", *SEGMENTATION_NAMES], default=None,
                    help="segmentation method (default auto: chosen on the data among threshold and alternating; "
                         "hyperplane when --hyperplane is given)")

@@ -18,7 +18,11 @@ Two ways to say what to try:
   would otherwise do by hand:
 
   1. **orders** (only those left as ``"auto"``: ``PWARXSearch(..., orders="auto")`` or a dict of
-     candidate lists): each (na, nb, nk) is scored as a single ARX model; the ``n_orders`` best go on;
+     candidate lists): each (na, nb, nk) is scored as a single ARX model; the ``n_orders`` best go on
+     (where a nearest-neighbour predictor's held-out one-step fit beats every ARX model's by
+     :data:`NEIGHBOUR_GATE` points, the orders it predicts best with go on in turn with them; the
+     delays 0 and 1 of :data:`ORDER_GRID` become the estimated dead time and one less where
+     :func:`~hwpts.identification.selection.orders.estimate_delays` finds one: see ``orders``);
   2. **regions**: for each kept order, one region (ARX), then 2, 3, ... regions with every method
      of ``methods``; the count grows until ``patience`` successive counts improve neither the best
      free-run score nor the best held-out one-step fit (on a system whose free run is chaotic the
@@ -99,7 +103,7 @@ MODES_GATE = (0.25, 10.0, 0.5)
 # the orders are ranked by a nearest-neighbour predictor's held-out one-step fit (selection/orders.py)
 # instead of the ARX models' where it beats the best ARX model's by this many points. Measured (best
 # neighbours / best ARX, held-out one-step %): oblique_3 ~83 / ~24 (every ARX order within 0.1 point:
-# a ranking by noise); the four real records 54-99.9 / 93-99.99, where the ARX ranking stands
+# a ranking by noise); the four real records 58.4-99.3 / 90.1-100, where the ARX ranking stands
 NEIGHBOUR_GATE = 10.0
 SCORINGS = ("auto", "free_run", "one_step")
 # "trailing" (:func:`_behind`): 2 points of free-run fit AND 20 % more one-step misfit (100 - fit)
@@ -299,7 +303,8 @@ class PWARXSearch(BaseEstimator):
         The delays estimated per input when the delays were searched as ``"auto"``, else ``None``.
     orders_ranking_ : dict or None
         How the carried orders were ranked (``ranked_by``: ``"arx"`` or ``"neighbours"``, with the
-        best held-out one-step fits of both); ``None`` when the orders were not searched.
+        best held-out one-step fits of both); ``None`` when the adaptive search had no orders to
+        rank (orders given, or searched in an explicit ``param_grid``).
     modes_gate_ : dict or None
         The shared-modes gate (``open``, the ``modes`` it opened at, the in-sample
         ``switched_fits_percent`` by number of modes, the ``best_one_step`` held-out fit it was
@@ -373,15 +378,21 @@ class PWARXSearch(BaseEstimator):
             self.input_delays_ = estimate_delays(u, y)
             grid["input_delay"] = tuple(delay_candidates(self.input_delays_))
 
-        def order_ok(v):
-            if isinstance(v, (list, tuple)):  # one per input
-                return len(v) > 0 and all(order_ok(x) for x in v)
+        n_inputs = u.shape[1]
+
+        def whole(v):
             return not isinstance(v, bool) and isinstance(v, (int, np.integer)) and v >= 0
 
+        def order_ok(key, v):
+            if key != "output_order" and isinstance(v, (list, tuple)):  # one per input
+                return len(v) == n_inputs and all(whole(x) for x in v)
+            return whole(v)
+
         for key, values in grid.items():
-            if isinstance(values, str) or not values or not all(order_ok(v) for v in values):
-                raise ParameterError(f"PWARXSearch: orders[{key!r}] must be non-empty ints >= 0 (or lists of them, "
-                                     f"one per input), got {values!r}")
+            if isinstance(values, str) or not values or not all(order_ok(key, v) for v in values):
+                per_input = "" if key == "output_order" else f" or lists of {n_inputs} of them (one per input)"
+                raise ParameterError(f"PWARXSearch: orders[{key!r}] must be non-empty ints >= 0{per_input}, "
+                                     f"got {values!r}")
         return expand_grid(grid)
 
     def n_training_rows(self, n_samples: int, max_lag: int = 0) -> int:
@@ -629,7 +640,7 @@ class PWARXSearch(BaseEstimator):
         # no predictor can beat an ARX model's fit above 100 - NEIGHBOUR_GATE by the gate: not
         # computed there (the four real records: 90.1-100 %)
         if self.order_ranking == "neighbours" and by_arx and arx_one < 100.0 - NEIGHBOUR_GATE:
-            grid = [dict(r["params"]) for r in arx_rows]
+            grid = [dict(r["params"]) for r in arx_rows if r["error"] is None]  # a failed ARX fails again
             seed = base.random_state if isinstance(base.random_state, (int, np.integer)) else 0
             fits = neighbour_fits(u, y, [self._orders_of(base, o) for o in grid], splits, random_state=seed)
             finite = [(f, i) for i, f in enumerate(fits) if np.isfinite(f)]
