@@ -222,15 +222,16 @@ def _fit_summary(model, data, path, out, elapsed, search=None, delays=None):
 
 def _delays_summary(delays):
     """The summary's account of the input delays searched (``None`` when ``--nk`` was given)."""
-    from hwpts.identification.selection.orders import DELAY_TOLERANCE, MAX_DELAY, delay_candidates
+    from hwpts.identification.selection.orders import DELAY_CHANCE, DELAY_TOLERANCE, MAX_DELAY, delay_candidates
 
     if delays is None:
         return None
     tried = delay_candidates(delays)
     why = (f"delays {tried} tried: an ARX model with each delay from 0 up to {MAX_DELAY} (or a tenth of the "
            f"record; as MATLAB's delayest) "
-           + ("found none above 1 that cut the loss of delays 0 and 1 by at least "
-              f"{100 * DELAY_TOLERANCE:g} %" if max(delays) <= 1 else "found the dead time " + str(list(delays))))
+           + ("found none above 1 that cut the loss of delays 0 and 1 by the larger of "
+              f"{100 * DELAY_TOLERANCE:g} % and {DELAY_CHANCE:g} / rows" if max(delays) <= 1
+              else "found the dead time " + str(list(delays))))
     return {"estimated": list(delays), "tried": tried, "why": why}
 
 
