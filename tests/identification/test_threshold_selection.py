@@ -184,7 +184,7 @@ def test_runner_up_orders_race_only_the_methods_that_survived_the_best_order(mon
     tried = []
 
     def scored(estimator, params, u, y, splits, prune_below=-np.inf, names=None, output_name=None, leader=None,
-               one_step=False):
+               one_step=False, best_row=None):
         tried.append(params)
         free, one = {"average": (50.0 - params["output_order"], 60.0), "threshold": (90.0, 99.0),
                      "alternating": (70.0, 80.0)}[params["segmentation"]]
@@ -200,8 +200,66 @@ def test_runner_up_orders_race_only_the_methods_that_survived_the_best_order(mon
     methods = {na: [p["segmentation"] for p in tried if p["output_order"] == na and p["segmentation"] != "average"]
                for na in (1, 2)}
     assert methods[1] == ["threshold", "alternating"] * 2 + ["threshold"]  # dropped after trailing twice
-    assert methods[2] == ["threshold"] * 3  # never raced on the runner-up order
+    # never raced on the runner-up order, whose threshold models tie the first order's at 2 and 3
+    # regions (90 %): not better than the leader of either count, it stops after `patience` counts
+    assert methods[2] == ["threshold"] * 2
     assert search.best_params_["segmentation"] == "threshold"
+
+
+def test_a_runner_up_order_races_the_leader_of_its_region_count(monkeypatch):
+    """The runner-up order's candidates with K regions are raced against the best row with K
+    regions (the order before it grown to 6 would prune any 2-region model), and the runner-up
+    grows while it beats the leader of each count (made-up scores: the first order 84 % at 2 regions
+    up to 92 % at 6; the runner-up 83 % at 2, then 1 point ahead at every count, and wins)."""
+    from hwpts.identification.selection import search as S
+
+    seen = []
+
+    def scored(estimator, params, u, y, splits, prune_below=-np.inf, names=None, output_name=None, leader=None,
+               one_step=False, best_row=None):
+        k, na = params["n_regions"], params["output_order"]
+        if params["segmentation"] == "average":
+            free = 50.0 - na
+        else:
+            free = (80.0 + 2.0 * min(k, 6)) if na == 1 else (83.0 if k == 2 else 81.0 + 2.0 * min(k, 6))
+        if na == 2 and params["segmentation"] != "average":
+            seen.append((k, None if leader is None else leader["params"]["n_regions"]))
+        n = len(splits)
+        return {"params": params, "split_fits_percent": [free] * n, "mean_fit_percent": free, "diverged": False,
+                "pruned": False, "error": None, "n_regions_fitted": k, "fit_time_s": 0.0,
+                "mean_one_step_fit_percent": free, "split_one_step_fits_percent": [free] * n}
+
+    monkeypatch.setattr(S, "_evaluate", scored)
+    u, y = setar(600, 0)
+    search = PWARXSearch(PWARX(random_state=0), orders={"output_order": [1, 2], "input_order": [1],
+                                                        "input_delay": [1]}, n_orders=2, try_polish=False,
+                         methods=("threshold",)).fit(u, y)
+    # raced against the same count's leader (none past the counts the first order tried: no race)
+    assert seen and all(lead == k for k, lead in seen[:7]) and all(lead in (k, None) for k, lead in seen)
+    assert [k for k, _ in seen][:5] == [2, 3, 4, 5, 6]  # behind at 2 (one miss), then ahead
+    assert search.best_params_["output_order"] == 2 and search.best_params_["n_regions"] == 6
+
+
+def test_a_running_mean_is_compared_with_the_same_blocks():
+    """Pruning compares a candidate's first blocks with the best candidate's *same* blocks: where
+    the first block is hard for every model (here the input barely moves in it, so the noise
+    dominates its fit), the right model's first-block fit lies far below the best complete mean of
+    a worse model, yet above that model's fit on the same block, and must not be pruned."""
+    rng = np.random.default_rng(0)
+    n = 1000
+    u = rng.uniform(-1, 1, n)
+    u[:200] *= 0.02  # the first of five blocks: almost no excitation
+    y = np.zeros(n)
+    for k in range(1, n):
+        y[k] = 0.9 * y[k - 1] + 0.5 * u[k - 1] + 0.02 * rng.standard_normal()
+    grid = [{"output_order": 0, "input_order": 4, "input_delay": 1, "segmentation": "average", "n_regions": 1},
+            {"output_order": 1, "input_order": 1, "input_delay": 1, "segmentation": "average", "n_regions": 1}]
+    search = PWARXSearch(PWARX(random_state=0), grid, cv=5, try_polish=False).fit(u[:, None], y)
+    fir, arx = search.cv_results_[0], search.cv_results_[1]
+    first_fir, first_arx = fir["split_fits_percent"][0], arx["split_fits_percent"][0]
+    assert first_arx < fir["mean_fit_percent"] - 10.0  # the old rule's prune ...
+    assert first_arx > first_fir  # ... of a model that leads on the same block
+    assert not arx["pruned"] and search.best_params_["output_order"] == 1
 
 
 def test_threshold_costs_are_reused_across_region_counts():
