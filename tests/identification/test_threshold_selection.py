@@ -176,6 +176,15 @@ def test_a_method_that_diverges_or_is_pruned_twice_stops_growing():
         assert search._still_racing(both, ["threshold", "alternating"], behind) == ["threshold", "alternating"]
 
 
+def made_up_row(params, splits, free, one):
+    """A complete table row with the same made-up free-run and one-step fit on every block (a
+    stand-in for ``search._evaluate`` in tests of the search's logic)."""
+    k = len(splits)
+    return {"params": params, "split_fits_percent": [free] * k, "mean_fit_percent": free, "diverged": False,
+            "pruned": False, "error": None, "n_regions_fitted": params["n_regions"], "fit_time_s": 0.0,
+            "mean_one_step_fit_percent": one, "split_one_step_fits_percent": [one] * k}
+
+
 def test_runner_up_orders_race_only_the_methods_that_survived_the_best_order(monkeypatch):
     """A method dropped from the race on the best ARX order is not raced on the runner-up orders
     (the scores here are made up: threshold 90 %, alternating 70 % on every order and count)."""
@@ -188,10 +197,7 @@ def test_runner_up_orders_race_only_the_methods_that_survived_the_best_order(mon
         tried.append(params)
         free, one = {"average": (50.0 - params["output_order"], 60.0), "threshold": (90.0, 99.0),
                      "alternating": (70.0, 80.0)}[params["segmentation"]]
-        k = len(splits)
-        return {"params": params, "split_fits_percent": [free] * k, "mean_fit_percent": free, "diverged": False,
-                "pruned": False, "error": None, "n_regions_fitted": params["n_regions"], "fit_time_s": 0.0,
-                "mean_one_step_fit_percent": one, "split_one_step_fits_percent": [one] * k}
+        return made_up_row(params, splits, free, one)
 
     monkeypatch.setattr(S, "_evaluate", scored)
     u, y = setar(600, 0)
@@ -224,10 +230,7 @@ def test_a_runner_up_order_races_the_leader_of_its_region_count(monkeypatch):
             free = (80.0 + 2.0 * min(k, 6)) if na == 1 else (83.0 if k == 2 else 81.0 + 2.0 * min(k, 6))
         if na == 2 and params["segmentation"] != "average":
             seen.append((k, None if leader is None else leader["params"]["n_regions"]))
-        n = len(splits)
-        return {"params": params, "split_fits_percent": [free] * n, "mean_fit_percent": free, "diverged": False,
-                "pruned": False, "error": None, "n_regions_fitted": k, "fit_time_s": 0.0,
-                "mean_one_step_fit_percent": free, "split_one_step_fits_percent": [free] * n}
+        return made_up_row(params, splits, free, free)
 
     monkeypatch.setattr(S, "_evaluate", scored)
     u, y = setar(600, 0)
@@ -255,10 +258,7 @@ def test_a_runner_up_order_that_trails_each_count_stops_growing(monkeypatch):
         free = 50.0 - na if params["segmentation"] == "average" else 80.0 + 2.0 * min(k, 6) - 10.0 * (na - 1)
         if na == 2 and params["segmentation"] != "average":
             counts.append(k)
-        n = len(splits)
-        return {"params": params, "split_fits_percent": [free] * n, "mean_fit_percent": free, "diverged": False,
-                "pruned": False, "error": None, "n_regions_fitted": k, "fit_time_s": 0.0,
-                "mean_one_step_fit_percent": free, "split_one_step_fits_percent": [free] * n}
+        return made_up_row(params, splits, free, free)
 
     monkeypatch.setattr(S, "_evaluate", scored)
     u, y = setar(600, 0)
