@@ -190,14 +190,11 @@ def _trails(fits, ones, leader) -> bool:
 
 
 def _same_blocks(row, j, one_step, fallback) -> float:
-    """Mean of ``row``'s first ``j`` block fits (one-step or free run), or ``fallback`` when there is
-    no such row (or ``fallback`` is -inf: no race)."""
+    """Mean of the complete row ``row``'s first ``j`` block fits (one-step or free run), or
+    ``fallback`` when there is no row (or ``fallback`` is -inf: no race)."""
     if row is None or not np.isfinite(fallback):
         return fallback
-    fits = row.get("split_one_step_fits_percent" if one_step else "split_fits_percent") or []
-    if len(fits) < j:
-        return fallback
-    return float(np.mean(fits[:j]))
+    return float(np.mean(row["split_one_step_fits_percent" if one_step else "split_fits_percent"][:j]))
 
 
 def _evaluate(estimator, params, u, y, splits, prune_below=-np.inf, names=None, output_name=None, leader=None,
@@ -208,9 +205,7 @@ def _evaluate(estimator, params, u, y, splits, prune_below=-np.inf, names=None, 
     ``prune_below`` over all blocks when no row is given; no race when ``prune_below`` is -inf), or
     whose first blocks trail the ``leader`` row's same blocks (:func:`_trails`), is not scored on
     its remaining blocks (``pruned``; ranked after the complete ones). The blocks differ in
-    difficulty (one holding a start-up excursion scored at most 28 % for every order of a record
-    whose other blocks scored 45-87 %), so a running mean is only compared with the same blocks'
-    mean."""
+    difficulty (module doc), so a running mean is only compared with the same blocks' mean."""
     row = {"params": params, "split_fits_percent": None, "mean_fit_percent": None, "diverged": False,
            "pruned": False, "error": None, "n_regions_fitted": None, "fit_time_s": None,
            "mean_one_step_fit_percent": None, "split_one_step_fits_percent": None}
