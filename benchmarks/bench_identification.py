@@ -243,7 +243,7 @@ def bench_real(lines):
                 grid += expand_grid({"output_order": [na], "input_order": [nb], "segmentation": ["threshold"],
                                      "n_regions": [2, 3], "polish": [False, True]})
         t0 = time.perf_counter()
-        search = PWARXSearch(base, grid, cv=5, try_polish=False, tolerance=0.0).fit(utr, ytr)
+        search = PWARXSearch(base, grid, cv=5, try_polish=False, tolerance=0.0, n_standard_errors=0.0).fit(utr, ytr)
         elapsed = time.perf_counter() - t0
         lines.append(f"pick_and_place: test free-run fit {search.score(ute, yte):.2f} % (plain ARX {arx:.2f} %), "
                      f"chosen on training only {search.best_params_} from {len(search.cv_results_)} candidates "

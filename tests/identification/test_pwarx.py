@@ -197,6 +197,10 @@ def test_search_scoring_is_checked():
     for bad in ("free-run", "r2", None, 1):
         with pytest.raises(ParameterError, match="scoring must be one of"):
             PWARXSearch(PWARX(1, 1, 1), scoring=bad).fit(u, y)
+    for name in ("tolerance", "n_standard_errors"):
+        for bad in (-0.5, True, "1", float("nan")):
+            with pytest.raises(ParameterError, match=f"{name} must be a number >= 0"):
+                PWARXSearch(PWARX(1, 1, 1), **{name: bad}).fit(u, y)
 
 
 def test_search_tries_shared_modes_when_switched_models_fit_far_better():

@@ -33,7 +33,7 @@ def test_pick_and_place(real_data):
     grid += expand_grid({"output_order": [2, 3], "input_order": [1, 2, 3], "segmentation": ["threshold"],
                          "n_regions": [2, 3], "polish": [True]})
     search = PWARXSearch(PWARX(input_delay=1, random_state=0), grid, cv=5, n_jobs=2, try_polish=False,
-                         tolerance=0.0)  # the best mean wins outright, as GridSearchCV
+                         tolerance=0.0, n_standard_errors=0.0)  # the best mean wins outright, as GridSearchCV
     model = search.fit(utr, ytr).best_estimator_
     chosen = next(r for r in search.cv_results_ if r.get("chosen"))
     fit = model.score(ute, yte)

@@ -269,6 +269,58 @@ def test_a_runner_up_order_that_trails_each_count_stops_growing(monkeypatch):
     assert search.best_params_["output_order"] == 1
 
 
+@pytest.mark.parametrize("case", ["noisy", "steady", "large"])
+def test_more_regions_must_beat_fewer_by_a_standard_error_of_the_block_differences(monkeypatch, case):
+    """The choice's one-standard-error rule, blocks paired: 4 regions score 1.2 points above 2
+    regions on the mean of five blocks (made-up block fits). Where the 2-region model is 5 points
+    above or below on single blocks (standard error of the differences 2.1) the gain is noise and
+    the fewer regions win; where it trails by about 1.2 on every block the 4 regions win, as they
+    do whenever the gain passes SE_CAP (the tolerance alone chose 4 regions in all three)."""
+    from hwpts.identification.selection import search as S
+
+    blocks = {("noisy", 2): [78.0, 88.0, 77.0, 86.0, 81.0], ("noisy", 4): [83.5, 83.5, 83.0, 83.0, 83.0],
+              ("steady", 2): [82.0, 81.8, 82.2, 81.9, 82.1], ("steady", 4): [83.1, 83.0, 83.4, 83.2, 83.3],
+              ("large", 2): [78.0, 88.0, 77.0, 86.0, 81.0], ("large", 4): [86.5, 86.5, 86.0, 86.0, 86.0]}
+
+    def scored(estimator, params, u, y, splits, prune_below=-np.inf, names=None, output_name=None, leader=None,
+               one_step=False, best_row=None):
+        fits = blocks[case, params["n_regions"]]
+        row = made_up_row(params, splits, float(np.mean(fits)), 99.0)
+        row["split_fits_percent"] = list(fits)
+        return row
+
+    monkeypatch.setattr(S, "_evaluate", scored)
+    u, y = setar(600, 0)
+    grid = [{"segmentation": "threshold", "n_regions": k} for k in (2, 4)]
+    chosen = {}
+    for n_se in (1.0, 0.0):
+        search = PWARXSearch(PWARX(1, 1, 1, random_state=0), grid, cv=5, try_polish=False,
+                             n_standard_errors=n_se).fit(u, y)
+        chosen[n_se] = search.best_params_["n_regions"]
+    assert chosen == {1.0: 2 if case == "noisy" else 4, 0.0: 4}
+
+
+def test_the_polish_must_beat_the_model_by_a_standard_error_of_the_block_differences(monkeypatch):
+    """The polish is kept by the same rule: a gain of 1.1 points (above the tolerance) made of block
+    differences of -4 to +6 points is noise; the same gain on every block is not."""
+    from hwpts.identification.selection import search as S
+
+    for polished, kept in (([84.0, 80.0, 88.0, 79.0, 85.5], False), ([83.1, 83.0, 83.2, 83.1, 83.1], True)):
+        def scored(estimator, params, u, y, splits, prune_below=-np.inf, names=None, output_name=None,
+                   leader=None, one_step=False, best_row=None, polished=polished):
+            fits = polished if params.get("polish") else [82.0] * 5
+            row = made_up_row(params, splits, float(np.mean(fits)), 99.0)
+            row["split_fits_percent"] = list(fits)
+            return row
+
+        monkeypatch.setattr(S, "_evaluate", scored)
+        u, y = setar(600, 0)
+        search = PWARXSearch(PWARX(1, 1, 1, random_state=0), [{"segmentation": "threshold", "n_regions": 2}],
+                             cv=5).fit(u, y)
+        assert bool(search.best_params_.get("polish")) is kept
+        assert search.best_estimator_.summary()["polished"] is kept
+
+
 def test_a_running_mean_is_compared_with_the_same_blocks():
     """Pruning compares a candidate's first blocks with the best candidate's *same* blocks: where
     the first block is hard for every model (here the input barely moves in it, so every model's

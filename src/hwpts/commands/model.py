@@ -210,8 +210,9 @@ def _fit_summary(model, data, path, out, elapsed, search=None, delays=None):
             "input_delays": _delays_summary(delays),
             "why": (f"best mean {'one-step' if search.scoring_ == 'one_step' else 'free-run'} fit over "
                     f"{search.n_splits_} held-out blocks of the training data "
-                    f"({len(table)} candidates; within {search.tolerance} points the fewest regions, then the "
-                    f"fewest parameters, win)"
+                    f"({len(table)} candidates; the fewest regions, then the fewest parameters, win unless the "
+                    f"best beats them by more than {search.tolerance} points and {search.n_standard_errors:g} "
+                    f"standard error(s) of the block differences)"
                     + (f"; ranked by the one-step fit because no ARX model's held-out free run reached "
                        f"{FREE_RUN_FLOOR:g} % fit" if search.scoring == "auto" and search.scoring_ == "one_step" else "")),
         }

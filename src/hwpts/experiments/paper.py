@@ -208,8 +208,10 @@ def _best_search(fracture: Fracture, polish: bool):
         grid += [{**g, "polish": True} for g in grid]
         labels += [f"{label}, simulation-error polish" for label in labels]
     base = PWARX(NA, NB, NK, segmentation="hyperplane", hyperplanes=hps)
-    # tolerance 0: the best held-out fit wins outright (the candidates share one partition)
-    return labels, PWARXSearch(base, grid, cv=HoldoutSplit(0.2), tolerance=0.0, try_polish=False)
+    # tolerance 0 on one held-out block: the best held-out fit wins outright (the candidates share
+    # one partition)
+    return labels, PWARXSearch(base, grid, cv=HoldoutSplit(0.2), tolerance=0.0, n_standard_errors=0.0,
+                               try_polish=False)
 
 
 def _score(model: PWARX, data: IODataset) -> tuple[float, float, np.ndarray]:
