@@ -194,6 +194,11 @@ CASES = [
     (["identify", f"{W}/data.csv", *FIT, "--na", "1", "--nb", "1", "--segmentation", "threshold", "--regions", "40",
       "--out", f"{W}/m.json"], "--regions 40: expected at most 33 for 400 samples"),
     (["identify", f"{W}/constant_y.csv", *FIT, "--out", f"{W}/m.json"], "output 'y' is constant"),
+    (["identify", f"{W}/data.csv", *FIXED, "--output-powers", "1,3", "--out", f"{W}/m.json"],
+     "--output-powers: expected 'auto', 'none' or distinct powers 2-9 such as 2,3; got '1,3'"),
+    (["identify", f"{W}/data.csv", *FIXED, "--output-powers", "cubic", "--out", f"{W}/m.json"], "--output-powers"),
+    (["identify", f"{W}/data.csv", *FIT, "--na", "0", "--nb", "2", "--output-powers", "2,3", "--out", f"{W}/m.json"],
+     "--output-powers 2,3: the power terms are of y(k-1), which --na 0 leaves out"),
     (["identify", f"{W}/data.csv", *FIXED, "--unit", "mm", "--out", f"{W}/m.json"], "--unit"),
     (["identify", f"{W}/data.csv", *FIXED, "--unit", "q=mm", "--out", f"{W}/m.json"], "--unit"),
     # --- identify: the output path

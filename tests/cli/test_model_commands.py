@@ -453,3 +453,36 @@ def test_identify_estimates_a_dead_time_when_nk_is_not_given(tmp_path, capsys):
     # a partition column among the lags of the estimated delay is a valid name (checked after it)
     assert main(base + ["--partition-column", "u(k-6)"]) == 0
     assert json.loads(capsys.readouterr().out)["choice"]["nk"] in ([5], [4])
+
+
+def test_identify_output_powers(tmp_path, capsys):
+    """``--output-powers``: ``auto`` lets the search try 2,3 and say so, on a hardening spring it
+    keeps them; ``none`` never tries them; ``2,3`` fixes them in the model file, which validate
+    and predict read back, while export (affine modes only) refuses with one line."""
+    rng = np.random.default_rng(0)
+    n = 1500
+    u = rng.uniform(-1, 1, n)
+    y = np.zeros(n)
+    for k in range(2, n):
+        y[k] = 1.5 * y[k - 1] - 0.7 * y[k - 2] - 0.2 * y[k - 1] ** 3 + 0.5 * u[k - 1]
+    y += 0.01 * rng.standard_normal(n)
+    path = tmp_path / "duffing.csv"
+    write_csv(path, {"u": u, "y": y})
+    base = ["identify", str(path), "--input", "u", "--output", "y", "--na", "2", "--nb", "1", "--nk", "1"]
+    assert main([*base, "--out", str(tmp_path / "auto.json")]) == 0
+    choice = json.loads(capsys.readouterr().out)["choice"]
+    assert choice["output_powers"]["tried"] and choice["output_powers"]["chosen"] == [2, 3]
+    assert main([*base, "--output-powers", "none", "--out", str(tmp_path / "none.json")]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert not summary["choice"]["output_powers"]["tried"] and "output_powers" not in summary
+    assert main([*base, "--regions", "1", "--segmentation", "average", "--output-powers", "3,2",
+                 "--out", str(tmp_path / "fixed.json")]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["output_powers"] == [2, 3] and summary["train_fit_percent"] > 95
+    stored = json.loads((tmp_path / "fixed.json").read_text())["structure"]
+    assert stored["output_powers"] == [2, 3] and stored["regressor_names"][-1] == "((y(k-1)-c)/s)^3"
+    assert main(["validate", str(tmp_path / "fixed.json"), str(path), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["fit_percent"] > 95
+    assert main(["export", str(tmp_path / "fixed.json"), "--format", "json", "--out", str(tmp_path / "ss.json")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "needs affine modes" in err and len(err.splitlines()) == 1 and not (tmp_path / "ss.json").exists()

@@ -20,6 +20,20 @@ def _int_list(text: str, name: str):
     return values[0] if len(values) == 1 else values
 
 
+def _output_powers(text: str):
+    """``--output-powers``: ``"auto"`` (the search tries them), ``()`` for ``none``, or the powers given."""
+    from hwpts.identification.regressors import MAX_POWER, check_output_powers
+
+    text = str(text).strip()
+    if text in ("auto", "none"):
+        return "auto" if text == "auto" else ()
+    try:
+        return check_output_powers([int(v) for v in text.split(",")])
+    except (ValueError, ParameterError):
+        raise ParameterError(f"--output-powers: expected 'auto', 'none' or distinct powers 2-{MAX_POWER} such as "
+                             f"2,3; got {text!r}") from None
+
+
 def _rows(text: str | None):
     if text is None:
         return slice(None)
@@ -208,6 +222,7 @@ def _fit_summary(model, data, path, out, elapsed, search=None, delays=None):
             "shared_modes": _modes_gate_summary(search),
             "orders": _orders_summary(search),
             "input_delays": _delays_summary(delays),
+            "output_powers": _powers_summary(search, model),
             "why": (f"best mean {'one-step' if search.scoring_ == 'one_step' else 'free-run'} fit over "
                     f"{search.n_splits_} held-out blocks of the training data "
                     f"({len(table)} candidates; the fewest regions, then the fewest parameters, win unless the "
@@ -219,6 +234,24 @@ def _fit_summary(model, data, path, out, elapsed, search=None, delays=None):
         summary["candidates"] = table
     summary["fit_time_s"] = round(elapsed, 3)
     return summary
+
+
+def _powers_summary(search, model):
+    """The summary's account of the output power terms: tried by the search or not, and chosen."""
+    chosen = list(model.structure_.output_powers)
+    rows = [r for r in search.cv_results_ if r.get("stage") == "powers"]
+    if not rows:
+        why = ("given (--output-powers)" if chosen else
+               "not tried (--output-powers none, a grid or a method and count given, or no output lag in the "
+               "model)")
+        return {"tried": False, "chosen": chosen, "why": why}
+    powers = list(rows[0]["params"]["output_powers"])
+    why = (f"the model chosen so far and the ARX model of its orders were scored with the terms "
+           f"((y(k-1)-c)/s)^p, p in {powers}, on the same held-out blocks; "
+           + ("they won the choice" if chosen else "they did not win the choice"))
+    return {"tried": True, "powers": powers, "chosen": chosen,
+            "heldout_fits_percent": [None if r["mean_fit_percent"] is None else round(r["mean_fit_percent"], 3)
+                                     for r in rows], "why": why}
 
 
 def _delays_summary(delays):
@@ -372,7 +405,11 @@ def cmd_identify(args) -> int:
     from hwpts.io.models import save_model
 
     _check_signals(args.input, args.output)
+    powers = _output_powers(args.output_powers)
     fixed, searched = _orders_to_search(args)
+    if powers not in ("auto", ()) and fixed.get("output_order") == 0:
+        raise ParameterError(f"--output-powers {args.output_powers}: the power terms are of y(k-1), which --na 0 "
+                             f"leaves out of the regressor; give --na >= 1 or --output-powers none")
     count = getattr(SEGMENTATION_METHODS.get(args.segmentation), "fixed_regions", None)
     if count is not None and args.regions != "auto" and str(args.regions).strip() != str(count):
         # a method that makes its own regions: --regions must agree or be left out
@@ -389,7 +426,8 @@ def cmd_identify(args) -> int:
     _check_partition_columns(args, fixed, searched)  # after the delays: "u(k-5)" names a column then
     if not searched:
         structure = RegressorStructure.create(fixed["output_order"], fixed["input_order"], fixed["input_delay"],
-                                              len(args.input), True, args.input, args.output)
+                                              len(args.input), True, args.input, args.output,
+                                              () if powers == "auto" else powers)
         structure.check_length(data.n_samples, what=_selection(args, str(args.data)))
     hyperplanes = [Hyperplane.parse(h) for h in args.hyperplane]
     segmentation = args.segmentation
@@ -431,6 +469,7 @@ def cmd_identify(args) -> int:
         hyperplanes=hyperplanes or None, region_models=region_models,
         ridge=args.ridge, polish=args.polish, random_state=args.seed,
         partition_columns=args.partition_column or None, sparse_partition=not args.all_partition_columns,
+        output_powers=() if powers == "auto" else powers,
     )
     search = None
     # the search scores the winner with the polish too, unless --polish already polishes every candidate
@@ -460,7 +499,8 @@ def cmd_identify(args) -> int:
         shared = {"auto": "auto", "on": True, "off": False}[args.shared_modes]
         if segmentation not in (None, "auto"):
             shared = False  # the method is the user's: no other is tried
-        search.set_params(scoring=args.scoring.replace("-", "_"), shared_modes=shared)
+        search.set_params(scoring=args.scoring.replace("-", "_"), shared_modes=shared,
+                          output_powers="auto" if powers == "auto" else None)
     t0 = time.perf_counter()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -750,6 +790,10 @@ def register(subparsers):
                    help="also try the switched segmentation (the distinct local models first, then the regions "
                         "each covers: equal parameters on disjoint regions); default auto: when some number of "
                         "switched linear models fits the training data far better than every candidate's regions")
+    p.add_argument("--output-powers", default="auto", metavar="auto|none|P,...",
+                   help="powers p of the standardised last output ((y(k-1)-c)/s)^p added to every mode's regressor, "
+                        "for a nonlinearity of the output such as a cubic spring (default auto: the model search "
+                        "tries 2,3 on its best model and on the ARX model of its orders; none: never; 2,3: always)")
     p.add_argument("--seed", type=non_negative_int, default=0, metavar="N", help="random seed (default 0)")
     p.add_argument("--unit", action="append", default=[], metavar="NAME=UNIT",
                    help="unit of a signal for plots and exports, e.g. y=mm (repeat; default: from the column "

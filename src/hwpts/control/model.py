@@ -60,6 +60,10 @@ class ModelBank:
         if not (math.isfinite(sample_time) and sample_time > 0):
             raise DataError(f"model sample time must be > 0 s, got {sample_time!r}")
         st = document["structure"]
+        if st.get("output_powers"):
+            raise DataError(f"the model's regressor has the output power terms {st['output_powers']}: the "
+                            f"controllers are designed from affine modes; identify without them "
+                            f"(hwpts identify --output-powers none)")
         names = [str(n) for n in st["input_names"]]
         if len(names) != 2 or not any(w in names[0].lower() for w in VALVE_WORDS) \
                 or not any(w in names[1].lower() for w in PUMP_WORDS):

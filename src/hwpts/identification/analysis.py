@@ -40,6 +40,7 @@ def to_control(model, dt=None) -> list:
     ``dt``: the sample time in seconds; ``None`` gives a discrete-time system with an unspecified
     sample time (``dt=True`` in python-control).
     """
+    _affine_only(model, "to_control")
     control = _control()
     if dt is not None and (isinstance(dt, bool) or not np.isfinite(dt) or dt <= 0):
         raise ParameterError(f"dt must be a positive number of seconds or None, got {dt!r}")
@@ -183,6 +184,7 @@ def state_space_export(model) -> dict:
     offset), ``c`` (output offset), ``poles``; ``H``, ``g`` per region: the region is
     ``{x : H x + g <= 0}`` over the regressor vector named ``regressor_names`` (eq. 9).
     """
+    _affine_only(model, "the state-space export")
     st = model.structure_
     modes = []
     for i, ss in enumerate(model.state_space()):
@@ -201,6 +203,14 @@ def state_space_export(model) -> dict:
         "modes": modes,
         "H": [np.asarray(h) for h in part.H], "g": [np.asarray(g) for g in part.g],
     }
+
+
+def _affine_only(model, what: str) -> None:
+    """Refuse a model with power terms of the output: its modes are not affine state-space systems."""
+    powers = model.structure_.output_powers
+    if powers:
+        raise ParameterError(f"{what} needs affine modes; this model's regressor has the output power terms "
+                             f"{list(powers)} (output_powers), which no state-space system holds")
 
 
 def _state_names(structure) -> list[str]:

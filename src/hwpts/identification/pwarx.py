@@ -107,6 +107,13 @@ class PWARX(BaseEstimator):
     polish : bool
         Refine the local parameters by minimising the free-run simulation error on the training
         data (partition fixed; see :mod:`hwpts.identification.polish`), kept only if better.
+    output_powers : sequence of int
+        Powers ``p`` (2-9) of the standardised last output, ``((y(k-1) - c) / s)^p`` with the
+        training output's mean ``c`` and standard deviation ``s``, appended to every mode's
+        regressor: a polynomial term for a nonlinearity that is a smooth function of the output
+        (a cubic spring), which affine pieces only approximate and cannot extrapolate. Default
+        ``()``: the paper's affine modes. The state-space forms are then the modes' linear parts
+        (:mod:`hwpts.identification.regressors`); :class:`PWARXSearch` tries ``(2, 3)`` by default.
     random_state : int, optional
         Seed of the numpy ``Generator`` used by randomised methods.
 
@@ -158,7 +165,7 @@ class PWARX(BaseEstimator):
                  segmentation="clustering", hyperplanes=None, region_models=None, constant=True,
                  ridge=0.0, refinement_rounds=3, classifier_C=1e4, segmentation_params=None,
                  polish=False, partition_columns=None, sparse_partition=True, max_rows=None,
-                 classifier_rows=None, random_state=None):
+                 classifier_rows=None, output_powers=(), random_state=None):
         self.output_order = output_order
         self.input_order = input_order
         self.input_delay = input_delay
@@ -176,6 +183,7 @@ class PWARX(BaseEstimator):
         self.sparse_partition = sparse_partition
         self.max_rows = max_rows
         self.classifier_rows = classifier_rows
+        self.output_powers = output_powers
         self.random_state = random_state
 
     # ------------------------------------------------------------------ fitting
@@ -243,7 +251,8 @@ class PWARX(BaseEstimator):
         n_inputs = u.shape[1]
         names = tuple(names) if names is not None else tuple(f"u{j + 1}" for j in range(n_inputs))
         structure = RegressorStructure.create(self.output_order, self.input_order, self.input_delay,
-                                              n_inputs, self.constant, names, oname or "y")
+                                              n_inputs, self.constant, names, oname or "y", self.output_powers,
+                                              float(np.mean(yy)), float(np.std(yy)) or 1.0)
         structure.check_length(yy.shape[0])
         for j, name in enumerate(names):
             if structure.nb[j] > 0 and np.ptp(u[:, j]) == 0:
@@ -461,7 +470,8 @@ class PWARX(BaseEstimator):
 
     # ------------------------------------------------------------------ analysis
     def state_space(self) -> list:
-        """State-space form (eq. 7) of every mode, with its poles (:class:`ModeStateSpace`)."""
+        """State-space form (eq. 7) of every mode, with its poles (:class:`ModeStateSpace`); with
+        ``output_powers``, of each mode's linear part (the linearisation at ``y(k-1) = c``)."""
         check_is_fitted(self, "theta_")
         return [mode_state_space(self.structure_, th) for th in self.theta_]
 
@@ -490,6 +500,7 @@ class PWARX(BaseEstimator):
         st = self.structure_
         return {
             "na": st.na, "nb": list(st.nb), "nk": list(st.nk), "constant": st.constant,
+            **({"output_powers": list(st.output_powers)} if st.output_powers else {}),
             "inputs": list(st.input_names), "output": st.output_name,
             "segmentation": self.segmentation_info_.get("method", str(self.segmentation)),
             "n_regions": int(self.n_regions_), "regions": regions,
@@ -513,7 +524,8 @@ class PWARX(BaseEstimator):
                 f"partition is over {partition.n_features} regressors, the structure has {structure.n_features}"
             )
         est = cls(output_order=structure.na, input_order=list(structure.nb), input_delay=list(structure.nk),
-                  n_regions=partition.n_regions, constant=structure.constant, **(params or {}))
+                  n_regions=partition.n_regions, constant=structure.constant,
+                  output_powers=tuple(structure.output_powers), **(params or {}))
         est.structure_ = structure
         est.partition_ = partition
         est.theta_ = theta

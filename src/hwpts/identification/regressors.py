@@ -10,6 +10,17 @@ The standard regression vector at sample ``k`` is (paper eq. 7, generalised to a
 
 and the extended regression vector is ``phi_k = [x_k' 1]'`` (eq. 6) when the model has a constant
 term, ``phi_k = x_k`` otherwise (a piecewise *linear* model).
+
+Optionally (``output_powers``, beyond the paper) ``x_k`` ends with powers of the standardised last
+output, ``((y(k-1) - c) / s)^p`` for each ``p`` (``c``, ``s``: the training output's mean and
+standard deviation, kept in the structure): a polynomial NARX term in every mode, for a system
+whose nonlinearity is a smooth function of the output (a cubic spring) that affine pieces only
+approximate and cannot extrapolate. The terms and ``y(k-1)`` span the polynomials in ``y(k-1)``
+up to the highest power when every lower power is there (``(2, 3)`` for a cubic: the cube of the
+centred output alone holds ``-3 c y^2``). The model stays linear in its parameters (least squares per
+region, the polish) but is no longer affine in its state: the modes' state-space form
+(:func:`~hwpts.identification.statespace.mode_state_space`) is then the linear part, the
+linearisation at ``y(k-1) = c``.
 """
 
 from __future__ import annotations
@@ -45,6 +56,25 @@ def as_order_tuple(value, n_inputs: int, name: str, minimum: int) -> tuple[int, 
     return values
 
 
+MAX_POWER = 9  # highest power term: (y - c) / s reaches tens on an output far outside its training range
+
+
+def check_output_powers(value) -> tuple[int, ...]:
+    """``output_powers`` as a sorted tuple of distinct ints in 2..MAX_POWER (``None``: empty)."""
+    if value is None:
+        return ()
+    if isinstance(value, (int, np.integer)) and not isinstance(value, bool):
+        value = (value,)
+    try:
+        items = list(value)
+    except TypeError:
+        raise ParameterError(f"output_powers must be a list of ints in 2..{MAX_POWER}, got {value!r}") from None
+    if any(isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not 2 <= v <= MAX_POWER for v in items) \
+            or len(set(int(v) for v in items)) != len(items):
+        raise ParameterError(f"output_powers must be distinct ints in 2..{MAX_POWER}, got {value!r}")
+    return tuple(sorted(int(v) for v in items))
+
+
 @dataclass(frozen=True)
 class RegressorStructure:
     """Orders of a MISO ARX structure and the names of its signals.
@@ -60,6 +90,11 @@ class RegressorStructure:
     constant : bool
         Whether the extended regressor ends with a constant 1 (eq. 6: an affine model).
     input_names, output_name : names used for the regressor column names.
+    output_powers : tuple of int
+        Powers ``p >= 2`` of the standardised last output ``((y(k-1) - c) / s)^p`` appended to
+        ``x_k`` (module doc); empty (the default): the paper's affine regressor.
+    power_center, power_scale : float
+        ``c`` and ``s`` of those terms (the training output's mean and standard deviation).
     """
 
     na: int
@@ -68,10 +103,14 @@ class RegressorStructure:
     constant: bool = True
     input_names: tuple[str, ...] = ()
     output_name: str = "y"
+    output_powers: tuple[int, ...] = ()
+    power_center: float = 0.0
+    power_scale: float = 1.0
 
     @classmethod
     def create(cls, na, nb, nk, n_inputs: int, constant: bool = True, input_names=None,
-               output_name: str | None = None) -> RegressorStructure:
+               output_name: str | None = None, output_powers=(), power_center: float = 0.0,
+               power_scale: float = 1.0) -> RegressorStructure:
         """Validate orders (int or one per input) and build the structure."""
         if not isinstance(na, (int, np.integer)) or isinstance(na, bool) or na < 0:
             raise ParameterError(f"na (output order) must be an int >= 0, got {na!r}")
@@ -85,7 +124,15 @@ class RegressorStructure:
             f"u{j + 1}" for j in range(n_inputs))
         if len(names) != n_inputs:
             raise ParameterError(f"{len(names)} input names for {n_inputs} inputs")
-        return cls(int(na), nb_t, nk_t, bool(constant), names, output_name or "y")
+        powers = check_output_powers(output_powers)
+        if powers and na < 1:
+            raise ParameterError(f"output_powers {list(powers)} need y(k-1) in the regressor: na (output order) "
+                                 f"must be >= 1, got {na}")
+        center, scale = float(power_center), float(power_scale)
+        if not (np.isfinite(center) and np.isfinite(scale) and scale > 0):
+            raise ParameterError(f"power_center must be finite and power_scale finite and > 0, got "
+                                 f"{power_center!r} and {power_scale!r}")
+        return cls(int(na), nb_t, nk_t, bool(constant), names, output_name or "y", powers, center, scale)
 
     @property
     def n_inputs(self) -> int:
@@ -99,9 +146,14 @@ class RegressorStructure:
         return max(0, *lags)
 
     @property
-    def n_features(self) -> int:
-        """Length of the standard regression vector x_k (eq. 7)."""
+    def n_linear(self) -> int:
+        """Columns of x_k that are lagged signals (eq. 7): the power terms follow them."""
         return self.na + sum(self.nb)
+
+    @property
+    def n_features(self) -> int:
+        """Length of the regression vector x_k (eq. 7, then the power terms, if any)."""
+        return self.na + sum(self.nb) + len(self.output_powers)
 
     @property
     def n_parameters(self) -> int:
@@ -117,7 +169,8 @@ class RegressorStructure:
         """The orders as text, such as ``na=5, nb=4, nk=0``."""
         nb = self.nb[0] if len(set(self.nb)) == 1 else list(self.nb)
         nk = self.nk[0] if len(set(self.nk)) == 1 else list(self.nk)
-        return f"na={self.na}, nb={nb}, nk={nk}"
+        powers = f", output powers {list(self.output_powers)}" if self.output_powers else ""
+        return f"na={self.na}, nb={nb}, nk={nk}{powers}"
 
     def check_length(self, n_samples: int, what: str = "DATA") -> None:
         """Raise :class:`DataError` when ``n_samples`` is too short for these orders."""
@@ -135,6 +188,7 @@ class RegressorStructure:
         for name, nb, nk in zip(self.input_names, self.nb, self.nk):
             for lag in range(nk, nk + nb):
                 names.append(f"{name}(k)" if lag == 0 else f"{name}(k-{lag})")
+        names += [f"(({self.output_name}(k-1)-c)/s)^{p}" for p in self.output_powers]
         return names
 
     @property
@@ -148,7 +202,23 @@ class RegressorStructure:
             for lg in range(nk, nk + nb):
                 sig.append(j)
                 lag.append(lg)
+        sig += [-1] * len(self.output_powers)
+        lag += [1] * len(self.output_powers)
         return np.asarray(sig, dtype=np.int64), np.asarray(lag, dtype=np.int64)
+
+    @property
+    def powers(self) -> np.ndarray:
+        """For each column of x_k: 1 for a lagged signal, ``p`` for a power term (module doc)."""
+        return np.asarray([1] * self.n_linear + list(self.output_powers), dtype=np.int64)
+
+    def with_powers(self, X: np.ndarray) -> np.ndarray:
+        """Fill the power-term columns of ``X`` (rows x_k) from its ``y(k-1)`` column, in place;
+        ``X`` is returned (nothing to do without power terms)."""
+        if self.output_powers:
+            z = (X[:, 0] - self.power_center) / self.power_scale
+            for q, p in enumerate(self.output_powers):
+                X[:, self.n_linear + q] = z ** p
+        return X
 
     def column_index(self, name: str) -> int:
         """Index in x_k of a regressor column, by regressor name (``u1(k-1)``) or input name.
@@ -194,7 +264,7 @@ class RegressorStructure:
             for lg in range(nk, nk + nb):
                 X[:, col] = u[m - lg : n - lg, j]
                 col += 1
-        return X, y[m:].copy()
+        return self.with_powers(X), y[m:].copy()
 
     def extend(self, X: np.ndarray) -> np.ndarray:
         """Extended regressors phi_k = [x_k' 1]' (eq. 6), or x_k without a constant term."""
@@ -204,17 +274,22 @@ class RegressorStructure:
 
     def to_dict(self) -> dict:
         """JSON-ready form (orders, names, regressor names) as stored in model files."""
-        return {
+        doc = {
             "na": self.na, "nb": list(self.nb), "nk": list(self.nk), "constant": self.constant,
             "input_names": list(self.input_names), "output_name": self.output_name,
             "regressor_names": self.feature_names,
         }
+        if self.output_powers:  # written only when present: affine models' files are as before
+            doc.update({"output_powers": list(self.output_powers), "power_center": self.power_center,
+                        "power_scale": self.power_scale})
+        return doc
 
     @classmethod
     def from_dict(cls, d: dict) -> RegressorStructure:
         """The structure from :meth:`to_dict`'s form (validated)."""
         return cls.create(d["na"], d["nb"], d["nk"], len(d["input_names"]), d["constant"],
-                          d["input_names"], d["output_name"])
+                          d["input_names"], d["output_name"], d.get("output_powers") or (),
+                          d.get("power_center", 0.0), d.get("power_scale", 1.0))
 
 
 MAX_ABS_VALUE = 1e100  # largest magnitude of a signal value: its square (and sums of them) stay finite

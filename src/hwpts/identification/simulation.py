@@ -57,7 +57,8 @@ class SimulationResult:
 
 
 @numba.njit(cache=True, nogil=True)
-def _simulate_kernel(u, y0, n_init, sig, lag, theta, H, g, row_start, center, bound):  # pragma: no cover - compiled
+def _simulate_kernel(u, y0, n_init, sig, lag, pw, pc, ps, theta, H, g, row_start, center,
+                     bound):  # pragma: no cover - compiled
     n = u.shape[0]
     nf = sig.shape[0]
     s = theta.shape[0]
@@ -69,9 +70,12 @@ def _simulate_kernel(u, y0, n_init, sig, lag, theta, H, g, row_start, center, bo
     for k in range(n_init, n):
         for c in range(nf):
             if sig[c] < 0:
-                x[c] = yhat[k - lag[c]]
+                v = yhat[k - lag[c]]
             else:
-                x[c] = u[k - lag[c], sig[c]]
+                v = u[k - lag[c], sig[c]]
+            if pw[c] != 1:  # a power term of the standardised output
+                v = ((v - pc) / ps) ** pw[c]
+            x[c] = v
         chosen = -1
         best = 0
         best_v = np.inf
@@ -102,7 +106,7 @@ def _simulate_kernel(u, y0, n_init, sig, lag, theta, H, g, row_start, center, bo
 
 
 @numba.njit(cache=True, nogil=True)
-def _sensitivity_kernel(u, yhat, regions, n_init, stop, sig, lag, theta):  # pragma: no cover - compiled
+def _sensitivity_kernel(u, yhat, regions, n_init, stop, sig, lag, pw, pc, ps, theta):  # pragma: no cover - compiled
     n = u.shape[0]
     nf = sig.shape[0]
     q = nf + 1
@@ -113,13 +117,18 @@ def _sensitivity_kernel(u, yhat, regions, n_init, stop, sig, lag, theta):  # pra
         base = r * q
         for c in range(nf):
             if sig[c] < 0:
-                J[k, base + c] = yhat[k - lag[c]]
+                v = yhat[k - lag[c]]
             else:
-                J[k, base + c] = u[k - lag[c], sig[c]]
+                v = u[k - lag[c], sig[c]]
+            if pw[c] != 1:
+                v = ((v - pc) / ps) ** pw[c]
+            J[k, base + c] = v
         J[k, base + nf] = 1.0
         for c in range(nf):  # the chain through the model's own past outputs
             if sig[c] < 0 and k - lag[c] >= n_init:
                 a = theta[r, c]
+                if pw[c] != 1:  # d/dy ((y - c) / s)^p = p ((y - c) / s)^(p - 1) / s
+                    a *= pw[c] * ((yhat[k - lag[c]] - pc) / ps) ** (pw[c] - 1) / ps
                 if a != 0.0:
                     kk = k - lag[c]
                     for j in range(width):
@@ -142,8 +151,14 @@ def free_run_sensitivity(structure, theta, inputs, sim: SimulationResult) -> np.
     sig, lag = structure.lags
     stop = u.shape[0] if not sim.diverged else int(sim.diverged_at)
     return _sensitivity_kernel(u, np.ascontiguousarray(sim.output, dtype=float), np.ascontiguousarray(sim.regions),
-                               min(sim.n_initial, u.shape[0]), stop, sig, lag,
+                               min(sim.n_initial, u.shape[0]), stop, sig, lag, *_power_args(structure),
                                np.ascontiguousarray(theta, dtype=float))
+
+
+def _power_args(structure) -> tuple:
+    """``(pw, pc, ps)`` of the kernels: each column's power (1: a lagged signal), the power terms'
+    center and scale."""
+    return structure.powers, float(structure.power_center), float(structure.power_scale)
 
 
 def simulate_pwarx(structure, partition, theta, inputs, initial_output, center=0.0, bound=np.inf) -> SimulationResult:
@@ -159,7 +174,7 @@ def simulate_pwarx(structure, partition, theta, inputs, initial_output, center=0
     sig, lag = structure.lags
     H, g, row_start = partition.flat()
     yhat, regions, k = _simulate_kernel(
-        u, y0, min(m, n), sig, lag, np.ascontiguousarray(theta, dtype=float), H, g, row_start,
+        u, y0, min(m, n), sig, lag, *_power_args(structure), np.ascontiguousarray(theta, dtype=float), H, g, row_start,
         float(center), float(bound),
     )
     if k >= 0:
@@ -219,6 +234,7 @@ def k_step_pwarx(structure, partition, theta, inputs, output, horizon: int,
             Xj = X.copy()
             for i in range(1, min(na, j - 1) + 1):
                 Xj[:, i - 1] = history[i - 1][t - i]
+            structure.with_powers(Xj)  # the power terms of the predicted y(k-1)
         regions = partition.predict(Xj)
         sel = th[regions]
         pred = np.einsum("ij,ij->i", Xj, sel[:, :-1]) + sel[:, -1]

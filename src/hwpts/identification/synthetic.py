@@ -145,6 +145,7 @@ def simulate_true_pwarx(structure, partition, theta, inputs, noise, initial_outp
     sig, lag = structure.lags
     for k in range(m, n):
         x = np.array([y[k - lg] if s < 0 else u[k - lg, s] for s, lg in zip(sig, lag)])
+        x = structure.with_powers(x[None])[0]
         r = int(partition.predict(x[None])[0])
         y[k] = theta[r, :-1] @ x + theta[r, -1] + noise[k]
         modes[k] = r

@@ -181,6 +181,14 @@ def _check_structure_types(st: dict) -> None:
         raise DataError(f"structure.output_name must be a string, got {type(st['output_name']).__name__}")
     if not isinstance(st["constant"], bool):
         raise DataError(f"structure.constant must be true or false, got {st['constant']!r}"[:200])
+    powers = st.get("output_powers")
+    if powers is not None:  # optional: a model with power terms of the output (later than schema /1's first files)
+        if not (isinstance(powers, list) and all(_is_int(x) for x in powers)):
+            raise DataError(f"structure.output_powers must be a list of ints, got {powers!r}"[:200])
+        for key in ("power_center", "power_scale"):
+            v = st.get(key)
+            if isinstance(v, bool) or not isinstance(v, (int, float)):
+                raise DataError(f"structure.{key} must be a number when output_powers is given, got {v!r}"[:200])
 
 
 def _signals_section(section, structure) -> tuple[float | None, dict]:

@@ -50,7 +50,13 @@ Two ways to say what to try:
      tried miss (equal parameters on disjoint regions): the ``switched`` segmentation (``K``
      modes, then the regions each covers) is tried on the leader's orders from that ``K`` up,
      grown as the regions are;
-  4. **choice**: the best score wins, but a candidate with fewer regions (then fewer parameters)
+  4. **output powers** (``output_powers``): the model the choice (step 5) would take so far, and
+     the single ARX model of its orders,
+     are also scored with the power terms ``((y(k-1) - c) / s)^p``, ``p`` in :data:`POWER_TERMS`
+     (a polynomial term in every mode: a smooth nonlinearity of the output, such as a cubic
+     spring, that affine pieces only approximate and cannot extrapolate); they compete in the
+     choice as any candidate, their two parameters a mode counted;
+  5. **choice**: the best score wins, but a candidate with fewer regions (then fewer parameters)
      is preferred unless the best *beats* it: by more than ``tolerance`` points and by more than
      ``n_standard_errors`` standard errors of their block-by-block differences (that term at most
      :data:`SE_CAP` points; :meth:`PWARXSearch._beats`). The simplest model the data support, as
@@ -58,7 +64,7 @@ Two ways to say what to try:
      Friedman, *Elements of Statistical Learning*, 7.10), with the blocks paired because they
      differ in difficulty. The score: the mean held-out free-run fit, or the one-step fit where
      ``scoring`` says so, by default where no ARX model's held-out free run reaches 10 % fit;
-  5. **polish** (``try_polish``): the winner is also scored with the simulation-error polish and
+  6. **polish** (``try_polish``): the winner is also scored with the simulation-error polish and
      polished if the polished model beats it by the same rule.
 
 Candidates of one stage are independent: a map over (parameters, split) pairs, run in processes
@@ -115,6 +121,10 @@ MODES_GATE = (0.25, 10.0, 0.5)
 # a ranking by noise); the four real records 58.4-99.3 / 90.1-100, where the ARX ranking stands
 NEIGHBOUR_GATE = 10.0
 SCORINGS = ("auto", "free_run", "one_step")
+# output_powers="auto": the powers of the standardised last output the adaptive search tries on the
+# leader and on its orders' ARX model (a square for asymmetry, a cube for a hardening or softening
+# spring: the polynomial NARX of the Silverbox literature is of degree 3)
+POWER_TERMS = (2, 3)
 # the choice (module doc, step 4): a more complex candidate, or the polish, must beat the simpler
 # one by ``tolerance`` and by ``n_standard_errors`` standard errors of the paired block differences,
 # that term capped at SE_CAP points. Measured (selection rules replayed on the searches' own
@@ -325,6 +335,10 @@ class PWARXSearch(BaseEstimator):
         below the ARX model's 0.7 %, and the free run cannot rank the models; the one-step fit
         then ranks them (decided once, after the ARX stage). An explicit ``param_grid`` with
         ``"auto"`` ranks by the free run.
+    output_powers : "auto", sequence of int, or None
+        Power terms the adaptive search tries (module doc, step 4): ``"auto"`` (default)
+        :data:`POWER_TERMS`, a list of powers (2-9), or ``None`` / ``()`` for none (nor when the
+        estimator has its own ``output_powers``, kept in every candidate).
 
     Attributes
     ----------
@@ -370,7 +384,7 @@ class PWARXSearch(BaseEstimator):
                  n_orders: int = 3, max_regions="auto", patience: int = 2, tolerance: float = 0.5,
                  try_polish="auto", refit_margin: float = 5.0, n_jobs=None, progress: bool = False,
                  scoring: str = "auto", shared_modes="auto", order_ranking: str = "neighbours",
-                 n_standard_errors: float = 1.0):
+                 n_standard_errors: float = 1.0, output_powers="auto"):
         self.estimator = estimator
         self.param_grid = param_grid
         self.cv = cv
@@ -388,6 +402,7 @@ class PWARXSearch(BaseEstimator):
         self.shared_modes = shared_modes
         self.order_ranking = order_ranking
         self.n_standard_errors = n_standard_errors
+        self.output_powers = output_powers
 
     # ------------------------------------------------------------------ helpers
     def _base(self):
@@ -536,6 +551,7 @@ class PWARXSearch(BaseEstimator):
         self.scoring_ = "one_step" if self.scoring == "one_step" else "free_run"
         if self.shared_modes not in (True, False, "auto"):
             raise ParameterError(f"PWARXSearch: shared_modes must be True, False or 'auto', got {self.shared_modes!r}")
+        self._powers = self._powers_to_try()
         if self.order_ranking not in ("neighbours", "arx"):
             raise ParameterError(f"PWARXSearch: order_ranking must be 'neighbours' or 'arx', got {self.order_ranking!r}")
         self.modes_gate_ = None
@@ -684,7 +700,41 @@ class PWARXSearch(BaseEstimator):
             if number == 0:
                 survivors = active
         table.extend(self._modes_stage(base, table, u, y, splits, bar))
+        table.extend(self._powers_stage(base, table, u, y, splits, bar))
         return table
+
+    def _powers_to_try(self) -> tuple[int, ...]:
+        """The power terms of the adaptive search's ``output_powers`` stage (validated)."""
+        from hwpts.identification.regressors import check_output_powers
+
+        if isinstance(self.output_powers, str):
+            if self.output_powers != "auto":
+                raise ParameterError(f"PWARXSearch: output_powers must be 'auto', a list of ints or None, "
+                                     f"got {self.output_powers!r}")
+            return POWER_TERMS
+        try:
+            return check_output_powers(self.output_powers)
+        except ParameterError as error:
+            raise ParameterError(f"PWARXSearch: {error}") from None
+
+    def _powers_stage(self, base, table, u, y, splits, bar):
+        """Rows of the model the choice would take so far (:meth:`_preference`) and of the single
+        ARX model of its orders with the power terms
+        (module doc, step 4); none when there are no powers to try, the estimator has its own, or
+        the leader has no output lag."""
+        if not self._powers or base.output_powers:
+            return []
+        if not any(np.isfinite(self._score(r)) for r in table):
+            return []
+        leader = self._preference(base, table, u)[0]  # the model the choice would take so far
+        orders = {k: leader["params"][k] for k in ORDER_KEYS if k in leader["params"]}
+        if self._orders_of(base, orders)[0] < 1:
+            return []
+        arx = {**orders, "segmentation": "average", "n_regions": 1, "segmentation_params": None}
+        cands = [{**arx, "output_powers": self._powers}]
+        if (leader["params"].get("n_regions") or 1) > 1:
+            cands.append({**leader["params"], "output_powers": self._powers})
+        return self._run(base, cands, u, y, splits, "powers", bar, self._score(leader), leader)
 
     def _carried_orders(self, base, by_arx, arx_rows, u, y, splits) -> list[dict]:
         """The ``n_orders`` orders carried to the region stage: the ARX ranking's best (``by_arx``),
@@ -840,7 +890,8 @@ class PWARXSearch(BaseEstimator):
     def _n_params(cls, base, orders, n_inputs) -> int:
         na, nb, _ = cls._orders_of(base, orders)
         nb = np.broadcast_to(np.atleast_1d(nb), (n_inputs,))
-        return int(na + int(np.sum(nb)) + 1)
+        powers = orders.get("output_powers", base.output_powers) or ()
+        return int(na + int(np.sum(nb)) + 1 + len(powers))
 
     def _rank(self, table):
         order = sorted(range(len(table)), key=lambda i: -self._score(table[i]))
