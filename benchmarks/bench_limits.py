@@ -250,7 +250,9 @@ def _print_silverbox():
         return
     p = sb["params"]
     print(f"2. Silverbox, the default search's model (na {p.get('output_order')}, nb {p.get('input_order')}, "
-          f"{p.get('segmentation')}, {p.get('n_regions')} regions{', polished' if p.get('polish') else ''}; "
+          f"{p.get('segmentation')}, {p.get('n_regions')} regions"
+          f"{', output powers ' + ','.join(map(str, p['output_powers'])) if p.get('output_powers') else ''}"
+          f"{', polished' if p.get('polish') else ''}; "
           f"search {sb['time']:.1f} s)")
     print(f"   training outputs span [{sb['train_range'][0]:.3f}, {sb['train_range'][1]:.3f}] V, the arrow's "
           f"[{sb['arrow_range'][0]:.3f}, {sb['arrow_range'][1]:.3f}] V ({100 * sb['beyond_share']:.2f} % of its "

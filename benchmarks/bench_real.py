@@ -155,7 +155,9 @@ def main(argv=None) -> int:
         model = search.best_estimator_
         st = model.structure_
         chosen = (f"na {st.na} nb {st.nb[0]} nk {st.nk[0]}, {model.segmentation_info_.get('method')}, "
-                  f"{model.n_regions_} regions{', polished' if model.summary()['polished'] else ''}")
+                  f"{model.n_regions_} regions"
+                  f"{', output powers ' + ','.join(map(str, st.output_powers)) if st.output_powers else ''}"
+                  f"{', polished' if model.summary()['polished'] else ''}")
         for test, (ut, yt) in tests.items():
             ya, n0a = _free_run(arx, ut, yt, n_init)
             yh, n0 = _free_run(model, ut, yt, n_init)

@@ -152,6 +152,7 @@ def run(name, seeds):
         best = search.best_estimator_
         st = best.structure_
         chosen.append(f"{st.na}/{st.nb[0]}/{st.nk[0]} {best.segmentation_info_.get('method')} {best.n_regions_}"
+                      f"{' powers ' + ','.join(map(str, st.output_powers)) if st.output_powers else ''}"
                       f"{' polished' if best.summary()['polished'] else ''}")
     return rows, chosen, times
 

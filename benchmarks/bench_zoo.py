@@ -185,6 +185,8 @@ def run_system(zoo, name, seeds, pyparc_py, progress=None, kw=None):
                 rows[key]["onestep"].append(onestep)
                 rows[key]["time"].append(elapsed)
                 rows[key]["n_regions"].append(int(model.n_regions_))
+                if key == "hwpts" and model.structure_.output_powers:
+                    notes.append(f"hwpts seed {seed}: output powers {list(model.structure_.output_powers)} chosen")
                 if dynamic:
                     sim = model.simulate(uv, v.output)
                     rows[key]["freerun"].append(np.nan if sim.diverged else one_step_fit(v.output[m:], sim.output[m:]))
@@ -306,6 +308,8 @@ def main(argv=None) -> int:
               f"{_med(rows['hwpts']['time'], '.2f'):>7s} {_med(rows['pyparc']['time'], '.2f'):>6s}  {fr}", flush=True)
         for note in notes[:3]:
             print(f"    note: {note}")
+        if len(notes) > 3:
+            print(f"    ({len(notes) - 3} more notes)")
         summary[name] = {k: {kk: [float(x) for x in vv] for kk, vv in v.items()} for k, v in rows.items()}
         summary[name]["reference"] = ref
     print(f"target: hwpts within {TARGET_GAP} points of the oracle's median one-step fit and at least PyPARC's "

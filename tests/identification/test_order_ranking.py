@@ -59,7 +59,9 @@ def test_the_neighbours_rank_the_true_orders_first_where_arx_cannot():
 
 def test_the_search_carries_the_neighbours_orders_where_no_arx_model_explains_the_data():
     u, y = oblique(1500, 0)
-    fast = {"n_orders": 1, "max_regions": 3, "try_polish": False, "shared_modes": False}
+    # the orders' ranking alone: without the power terms (with them the ARX ranking's 3/2/1 scores
+    # 69.6 % held out, the cube bending its affine pieces toward the oblique boundaries)
+    fast = {"n_orders": 1, "max_regions": 3, "try_polish": False, "shared_modes": False, "output_powers": None}
     search = PWARXSearch(PWARX(random_state=0), orders=SMALL_GRID, **fast).fit(u, y)
     info = search.orders_ranking_
     assert info["ranked_by"] == "neighbours"
