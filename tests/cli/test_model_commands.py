@@ -486,3 +486,24 @@ def test_identify_output_powers(tmp_path, capsys):
     assert main(["export", str(tmp_path / "fixed.json"), "--format", "json", "--out", str(tmp_path / "ss.json")]) == 2
     err = capsys.readouterr().err.strip()
     assert "needs affine modes" in err and len(err.splitlines()) == 1 and not (tmp_path / "ss.json").exists()
+
+
+def test_identify_output_powers_name_a_partition_column_and_count_in_the_region_limit(tmp_path, capsys):
+    """With ``--output-powers``, a power term is a valid ``--partition-column`` and its parameters
+    count in ``--regions``' limit (a review found both left out)."""
+    rng = np.random.default_rng(1)
+    n = 800
+    u = rng.uniform(-1, 1, n)
+    y = np.zeros(n)
+    for k in range(2, n):
+        y[k] = 1.5 * y[k - 1] - 0.7 * y[k - 2] - 0.2 * y[k - 1] ** 3 + 0.5 * u[k - 1]
+    path = tmp_path / "d.csv"
+    write_csv(path, {"u": u, "y": y})
+    base = ["identify", str(path), "--input", "u", "--output", "y", "--na", "2", "--nb", "1", "--nk", "1",
+            "--segmentation", "threshold"]
+    assert main([*base, "--regions", "2", "--output-powers", "2", "--partition-column", "((y(k-1)-c)/s)^2",
+                 "--out", str(tmp_path / "m.json")]) == 0
+    assert json.loads(capsys.readouterr().out)["segmentation"] == "threshold"
+    assert main([*base, "--regions", "50", "--output-powers", "2,3", "--out", str(tmp_path / "m50.json")]) == 2
+    err = capsys.readouterr().err
+    assert "--regions 50: expected at most 44 for 800 samples" in err and "6 parameters a region" in err

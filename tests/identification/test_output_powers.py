@@ -185,3 +185,23 @@ def test_the_search_adds_the_powers_where_the_data_ask_for_them():
     for bad in ("yes", [1], [2, 2]):
         with pytest.raises(ParameterError, match="PWARXSearch: output_powers"):
             PWARXSearch(PWARX(1, 1, 1), output_powers=bad).fit(v[:, None], w)
+
+
+def test_the_search_takes_powers_in_any_form_the_model_takes():
+    """An int, an array or a grid of powers: the search counts their parameters as the model does
+    (a review found ``len(3)`` and an array's truth value raising here), and an estimator with its
+    own powers is searched only over orders with an output lag."""
+    u, y = duffing(800, 8)
+    for powers in (3, np.array([2, 3])):
+        search = PWARXSearch(PWARX(2, 1, 1, random_state=0, output_powers=powers), max_regions=2).fit(u, y)
+        assert search.best_estimator_.structure_.output_powers == tuple(np.atleast_1d(powers))
+        assert not any(r["stage"] == "powers" for r in search.cv_results_)
+    grid = PWARXSearch(PWARX(2, 1, 1), param_grid={"output_powers": [(), 3, (2, 3)], "n_regions": [1],
+                                                    "segmentation": ["average"]}, try_polish=False).fit(u, y)
+    assert grid.best_params_["output_powers"] == (2, 3)
+    orders = PWARXSearch(PWARX(random_state=0, output_powers=(2, 3)), max_regions=1,
+                         orders={"output_order": [0, 2], "input_order": [1], "input_delay": [1]}).fit(u, y)
+    assert all(r["params"]["output_order"] == 2 for r in orders.cv_results_)
+    with pytest.raises(ParameterError, match="need an output order >= 1"):
+        PWARXSearch(PWARX(output_powers=(2,)), orders={"output_order": [0], "input_order": [1],
+                                                        "input_delay": [1]}).fit(u, y)

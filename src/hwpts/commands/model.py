@@ -322,7 +322,7 @@ def _orders_to_search(args):
     return fixed, searched
 
 
-def _check_region_count(n_regions, n_samples, fixed, searched, n_inputs, searching) -> None:
+def _check_region_count(n_regions, n_samples, fixed, searched, n_inputs, searching, powers=()) -> None:
     """``--regions S`` leaves every region ``ROWS_PER_PARAMETER`` rows a parameter of the smallest
     candidate model (the orders given, else the smallest of the search's grid), in the rows each
     candidate is fitted on (``searching``: the training part of the search's cross-validation): the
@@ -342,7 +342,7 @@ def _check_region_count(n_regions, n_samples, fixed, searched, n_inputs, searchi
     best = None
     for na, nb, nk in itertools.product(*grid):
         try:
-            st = RegressorStructure.create(na, nb, nk, n_inputs, True)
+            st = RegressorStructure.create(na, nb, nk, n_inputs, True, output_powers=powers)
         except ParameterError:
             continue  # e.g. na = 0 with nb = 0: refused where the model is built, with its own message
         rows = PWARXSearch().n_training_rows(n_samples, st.max_lag) if searching else n_samples
@@ -373,7 +373,7 @@ def _check_signals(inputs, output) -> None:
                              f"inputs (it would predict y(k) from y(k) itself)")
 
 
-def _check_partition_columns(args, fixed, searched) -> None:
+def _check_partition_columns(args, fixed, searched, powers=()) -> None:
     """Every ``--partition-column`` names a regressor column of some candidate structure (the
     largest orders of the search, each delay), so a misspelt name fails at once and names the flag."""
     from hwpts.identification.regressors import RegressorStructure
@@ -385,7 +385,8 @@ def _check_partition_columns(args, fixed, searched) -> None:
     delays = [fixed["input_delay"]] if "input_delay" in fixed else list(searched.get("input_delay", [1]))
     names = []
     for nk in delays:
-        structure = RegressorStructure.create(na, nb, nk, len(args.input), True, args.input, args.output)
+        structure = RegressorStructure.create(na, nb, nk, len(args.input), True, args.input, args.output,
+                                              powers if na >= 1 else ())
         names += [name for name in structure.feature_names if name not in names]
     valid = {*names, *args.input, args.output}
     for name in args.partition_column:
@@ -423,7 +424,8 @@ def cmd_identify(args) -> int:
 
         delays = estimate_delays(data.inputs, data.output)
         searched["input_delay"] = delay_candidates(delays)
-    _check_partition_columns(args, fixed, searched)  # after the delays: "u(k-5)" names a column then
+    # after the delays: "u(k-5)" names a column then; a power term is a column when --output-powers gives it
+    _check_partition_columns(args, fixed, searched, () if powers == "auto" else powers)
     if not searched:
         structure = RegressorStructure.create(fixed["output_order"], fixed["input_order"], fixed["input_delay"],
                                               len(args.input), True, args.input, args.output,
@@ -450,7 +452,8 @@ def cmd_identify(args) -> int:
             raise ParameterError(f"--regions expects an int >= 1, got {n_regions}")
     if segmentation not in ("hyperplane", "average", "zscore"):
         _check_region_count(n_regions, data.n_samples, fixed, searched, len(args.input),
-                            searching=bool(searched) or segmentation == "auto")
+                            searching=bool(searched) or segmentation == "auto",
+                            powers=() if powers == "auto" else powers)
     region_models = None
     if args.zero_region:
         n_hyper = len(hyperplanes) + 1 if segmentation == "hyperplane" else n_regions

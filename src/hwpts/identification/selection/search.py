@@ -446,6 +446,14 @@ class PWARXSearch(BaseEstimator):
                 per_input = "" if key == "output_order" else f" or lists of {n_inputs} of them (one per input)"
                 raise ParameterError(f"PWARXSearch: orders[{key!r}] must be non-empty ints >= 0{per_input}, "
                                      f"got {values!r}")
+        from hwpts.identification.regressors import check_output_powers
+
+        if check_output_powers(base.output_powers) and "output_order" in grid:
+            # the estimator's own power terms are of y(k-1): an order without it cannot hold them
+            grid["output_order"] = tuple(v for v in grid["output_order"] if v >= 1)
+            if not grid["output_order"]:
+                raise ParameterError(f"PWARXSearch: the estimator's output_powers {list(base.output_powers)} need "
+                                     f"an output order >= 1, and orders['output_order'] has none")
         return expand_grid(grid)
 
     def n_training_rows(self, n_samples: int, max_lag: int = 0) -> int:
@@ -722,7 +730,9 @@ class PWARXSearch(BaseEstimator):
         ARX model of its orders with the power terms
         (module doc, step 4); none when there are no powers to try, the estimator has its own, or
         the leader has no output lag."""
-        if not self._powers or base.output_powers:
+        from hwpts.identification.regressors import check_output_powers
+
+        if not self._powers or check_output_powers(base.output_powers):
             return []
         if not any(np.isfinite(self._score(r)) for r in table):
             return []
@@ -836,7 +846,9 @@ class PWARXSearch(BaseEstimator):
         fits = {}
         if best_one > 100.0 - MODES_GATE[1]:  # no fit can be MODES_GATE[1] points above it
             return {"open": False, "modes": None, "switched_fits_percent": fits, "best_one_step": best_one}
-        structure = RegressorStructure.create(*self._orders_of(base, orders), u.shape[1], base.constant)
+        structure = RegressorStructure.create(*self._orders_of(base, orders), u.shape[1], base.constant,
+                                              output_powers=base.output_powers, power_center=float(np.mean(y)),
+                                              power_scale=float(np.std(y)) or 1.0)
         X, t = structure.build(u, y)
         seed = base.random_state if isinstance(base.random_state, (int, np.integer)) else 0
         for k in range(1, top + 1):
@@ -890,7 +902,9 @@ class PWARXSearch(BaseEstimator):
     def _n_params(cls, base, orders, n_inputs) -> int:
         na, nb, _ = cls._orders_of(base, orders)
         nb = np.broadcast_to(np.atleast_1d(nb), (n_inputs,))
-        powers = orders.get("output_powers", base.output_powers) or ()
+        from hwpts.identification.regressors import check_output_powers
+
+        powers = check_output_powers(orders.get("output_powers", base.output_powers))
         return int(na + int(np.sum(nb)) + 1 + len(powers))
 
     def _rank(self, table):
