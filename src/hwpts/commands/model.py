@@ -246,9 +246,12 @@ def _powers_summary(search, model):
                "model)")
         return {"tried": False, "chosen": chosen, "why": why}
     powers = list(rows[0]["params"]["output_powers"])
-    why = (f"the model chosen so far and the ARX model of its orders were scored with the terms "
-           f"((y(k-1)-c)/s)^p, p in {powers}, on the same held-out blocks; "
-           + ("they won the choice" if chosen else "they did not win the choice"))
+    why = (f"the ARX model of the orders of the model chosen so far was scored with the terms ((y(k-1)-c)/s)^p, "
+           f"p in {powers}, on the same held-out blocks"
+           + (", and so was that model, the ARX model being raced to the end" if len(rows) > 1 else
+              " and pruned or diverged, so the regions were not tried with them"
+              if rows[0]["mean_fit_percent"] is None else "")
+           + ("; they won the choice" if chosen else "; they did not win the choice"))
     return {"tried": True, "powers": powers, "chosen": chosen,
             "heldout_fits_percent": [None if r["mean_fit_percent"] is None else round(r["mean_fit_percent"], 3)
                                      for r in rows], "why": why}
