@@ -799,7 +799,8 @@ def register(subparsers):
     p.add_argument("--output-powers", default="auto", metavar="auto|none|P,...",
                    help="powers p of the standardised last output ((y(k-1)-c)/s)^p added to every mode's regressor, "
                         "for a nonlinearity of the output such as a cubic spring (default auto: the model search "
-                        "tries 2,3 on its best model and on the ARX model of its orders; none: never; 2,3: always)")
+                        "tries 2,3 on the ARX model of its best model's orders, then on that model if the ARX model "
+                        "holds its own; none: never; 2,3: always)")
     p.add_argument("--seed", type=non_negative_int, default=0, metavar="N", help="random seed (default 0)")
     p.add_argument("--unit", action="append", default=[], metavar="NAME=UNIT",
                    help="unit of a signal for plots and exports, e.g. y=mm (repeat; default: from the column "
