@@ -205,3 +205,53 @@ def test_the_search_takes_powers_in_any_form_the_model_takes():
     with pytest.raises(ParameterError, match="need an output order >= 1"):
         PWARXSearch(PWARX(output_powers=(2,)), orders={"output_order": [0], "input_order": [1],
                                                         "input_delay": [1]}).fit(u, y)
+
+
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+PROPERTY = settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+
+
+@PROPERTY
+@given(na=st.integers(1, 3), nb=st.integers(0, 2), powers=st.sets(st.integers(2, 4), min_size=1, max_size=3),
+       seed=st.integers(0, 2**16))
+def test_property_compiled_free_run_matches_the_reference_loop(na, nb, powers, seed):
+    """Any orders and powers: the compiled free run (and the sensitivity kernel's rows) against the
+    plain Python loop of :func:`simulate_true_pwarx`, for a stable random model."""
+    from hwpts.identification.partition import RegionPartition
+    from hwpts.identification.simulation import simulate_pwarx
+    from hwpts.identification.synthetic import simulate_true_pwarx
+
+    rng = np.random.default_rng(seed)
+    st_ = RegressorStructure.create(na, nb, 1, 1, output_powers=powers, power_center=rng.normal(),
+                                    power_scale=rng.uniform(0.5, 2.0))
+    theta = np.zeros((1, st_.n_features + 1))
+    theta[0, :na] = rng.uniform(-0.4, 0.4, na) / na
+    theta[0, na:st_.n_linear] = rng.normal(size=nb)
+    theta[0, st_.n_linear:-1] = rng.uniform(-0.01, 0.01, len(powers))
+    theta[0, -1] = rng.normal()
+    u = rng.uniform(-1, 1, (200, 1))
+    y0 = rng.normal(size=st_.max_lag)
+    part = RegionPartition.single(st_.n_features)
+    sim = simulate_pwarx(st_, part, theta, u, y0, 0.0, 1e6)
+    ref, _ = simulate_true_pwarx(st_, part, theta, u, np.zeros(200), y0)
+    if not sim.diverged:
+        np.testing.assert_allclose(sim.output, ref, rtol=1e-9, atol=1e-9)
+
+
+@PROPERTY
+@given(scale=st.sampled_from([1e-6, 1e-3, 1.0, 1e3, 1e6]), shift=st.sampled_from([0.0, -50.0, 1e4]),
+       seed=st.integers(0, 100))
+def test_property_power_terms_do_not_depend_on_the_data_units(scale, shift, seed):
+    """The terms are of the standardised output, so a model of ``a y + b`` predicts ``a yhat + b``:
+    its fit on the same data is the same whatever the units (a cube of raw outputs offset by 1e4
+    would be 1e12, collinear with the square and the output). The offset is ``shift`` times the
+    output's scale: at 1e5 and a scale of 1e-6 the lagged outputs themselves are collinear."""
+    u, y = duffing(600, seed)
+    offset = shift * scale
+    ref = PWARX(2, 1, 1, n_regions=1, segmentation="average", output_powers=(2, 3)).fit(u, y)
+    moved = PWARX(2, 1, 1, n_regions=1, segmentation="average", output_powers=(2, 3)).fit(u, scale * y + offset)
+    one = ref.predict(u, y)
+    np.testing.assert_allclose(moved.predict(u, scale * y + offset), scale * one + offset,
+                               rtol=1e-7, atol=1e-7 * scale * np.std(y))
