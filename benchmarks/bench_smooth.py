@@ -27,6 +27,8 @@ import warnings
 
 import numpy as np
 
+from benchmarks.bench_unseen import chosen_label, seeds_and_systems
+
 NOISE = 0.02
 N_TRAIN, N_VALID = 2000, 3000
 GROWTH = 1.25  # the extrapolation record's input amplitude, relative to the training one
@@ -96,27 +98,16 @@ def run(name, seeds):
                 for key, model in (("hwpts", search.best_estimator_), ("hwpts, no powers", plain.best_estimator_),
                                    ("ARX", arx)):
                     rows[key, label].append(model.simulate(uv, yv).score(yv))
-        best = search.best_estimator_
-        st = best.structure_
-        chosen.append(f"{st.na}/{st.nb[0]}/{st.nk[0]} {best.segmentation_info_.get('method')} {best.n_regions_}"
-                      f"{' powers ' + ','.join(map(str, st.output_powers)) if st.output_powers else ''}"
-                      f"{' polished' if best.summary()['polished'] else ''}")
+        chosen.append(chosen_label(search.best_estimator_))
     return rows, chosen, times, beyond
 
 
 def main(argv=None) -> int:
-    argv = list(argv or [])
-    n_seeds, names = 3, list(SYSTEMS)
-    for a in argv:
-        if a.startswith("--seeds="):
-            n_seeds = max(1, int(a.split("=", 1)[1]))
-        elif a.startswith("--systems="):
-            names = a.split("=", 1)[1].split(",")
-    unknown = [n for n in names if n not in SYSTEMS]
-    if unknown:
-        print(f"smooth: unknown system(s) {unknown}; available: {list(SYSTEMS)}", file=sys.stderr)
+    parsed = seeds_and_systems(list(argv or []), SYSTEMS, "smooth")
+    if parsed is None:
         return 2
-    seeds = list(range(n_seeds))
+    seeds, names = parsed
+    n_seeds = len(seeds)
     print(f"free-run fit % on noise-free data, median [min, max] over {n_seeds} seed(s); {N_TRAIN} training "
           f"samples, noise {NOISE:.0%} of the output's std; extrapolation: inputs x{GROWTH}")
 

@@ -149,27 +149,40 @@ def run(name, seeds):
         rows["hwpts, true orders"].append(_free_fit(told.best_estimator_, *valid))
         rows["oracle"].append(oracle_fit(S, train, valid))
         rows["ARX"].append(_free_fit(arx, *valid))
-        best = search.best_estimator_
-        st = best.structure_
-        chosen.append(f"{st.na}/{st.nb[0]}/{st.nk[0]} {best.segmentation_info_.get('method')} {best.n_regions_}"
-                      f"{' powers ' + ','.join(map(str, st.output_powers)) if st.output_powers else ''}"
-                      f"{' polished' if best.summary()['polished'] else ''}")
+        chosen.append(chosen_label(search.best_estimator_))
     return rows, chosen, times
 
 
-def main(argv=None) -> int:
-    argv = list(argv or [])
-    n_seeds, names = 3, list(SYSTEMS)
+def chosen_label(model) -> str:
+    """``na/nb/nk method regions [powers p,q] [polished]`` of a fitted model."""
+    st = model.structure_
+    return (f"{st.na}/{st.nb[0]}/{st.nk[0]} {model.segmentation_info_.get('method')} {model.n_regions_}"
+            f"{' powers ' + ','.join(map(str, st.output_powers)) if st.output_powers else ''}"
+            f"{' polished' if model.summary()['polished'] else ''}")
+
+
+def seeds_and_systems(argv, systems, label):
+    """``(seeds, names)`` from ``--seeds=N`` (3) and ``--systems=a,b`` (all of ``systems``), or
+    ``None`` after naming an unknown system on stderr."""
+    n_seeds, names = 3, list(systems)
     for a in argv:
         if a.startswith("--seeds="):
             n_seeds = max(1, int(a.split("=", 1)[1]))
         elif a.startswith("--systems="):
             names = a.split("=", 1)[1].split(",")
-    unknown = [n for n in names if n not in SYSTEMS]
+    unknown = [n for n in names if n not in systems]
     if unknown:
-        print(f"unseen: unknown system(s) {unknown}; available: {list(SYSTEMS)}", file=sys.stderr)
+        print(f"{label}: unknown system(s) {unknown}; available: {list(systems)}", file=sys.stderr)
+        return None
+    return list(range(n_seeds)), names
+
+
+def main(argv=None) -> int:
+    parsed = seeds_and_systems(list(argv or []), SYSTEMS, "unseen")
+    if parsed is None:
         return 2
-    seeds = list(range(n_seeds))
+    seeds, names = parsed
+    n_seeds = len(seeds)
     print(f"free-run fit % on noise-free validation, median [min, max] over {n_seeds} seed(s); "
           f"{N_TRAIN} training samples, noise {NOISE:.0%} of the output's std")
     print(f"{'system':24s} {'hwpts':>22s} {'hwpts, true orders':>22s} {'oracle':>22s} {'ARX':>8s} "

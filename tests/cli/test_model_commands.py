@@ -455,19 +455,23 @@ def test_identify_estimates_a_dead_time_when_nk_is_not_given(tmp_path, capsys):
     assert json.loads(capsys.readouterr().out)["choice"]["nk"] in ([5], [4])
 
 
-def test_identify_output_powers(tmp_path, capsys):
-    """``--output-powers``: ``auto`` lets the search try 2,3 and say so, on a hardening spring it
-    keeps them; ``none`` never tries them; ``2,3`` fixes them in the model file, which validate
-    and predict read back, while export (affine modes only) refuses with one line."""
-    rng = np.random.default_rng(0)
-    n = 1500
+def _duffing_csv(path, n, seed, noise=0.0):
+    """A hardening spring (a cube of the output, Silverbox's physics) as ``u,y`` CSV at ``path``."""
+    rng = np.random.default_rng(seed)
     u = rng.uniform(-1, 1, n)
     y = np.zeros(n)
     for k in range(2, n):
         y[k] = 1.5 * y[k - 1] - 0.7 * y[k - 2] - 0.2 * y[k - 1] ** 3 + 0.5 * u[k - 1]
-    y += 0.01 * rng.standard_normal(n)
-    path = tmp_path / "duffing.csv"
+    y += noise * rng.standard_normal(n)
     write_csv(path, {"u": u, "y": y})
+    return path
+
+
+def test_identify_output_powers(tmp_path, capsys):
+    """``--output-powers``: ``auto`` lets the search try 2,3 and say so, on a hardening spring it
+    keeps them; ``none`` never tries them; ``2,3`` fixes them in the model file, which validate
+    and predict read back, while export (affine modes only) refuses with one line."""
+    path = _duffing_csv(tmp_path / "duffing.csv", 1500, seed=0, noise=0.01)
     base = ["identify", str(path), "--input", "u", "--output", "y", "--na", "2", "--nb", "1", "--nk", "1"]
     assert main([*base, "--out", str(tmp_path / "auto.json")]) == 0
     choice = json.loads(capsys.readouterr().out)["choice"]
@@ -491,14 +495,7 @@ def test_identify_output_powers(tmp_path, capsys):
 def test_identify_output_powers_name_a_partition_column_and_count_in_the_region_limit(tmp_path, capsys):
     """With ``--output-powers``, a power term is a valid ``--partition-column`` and its parameters
     count in ``--regions``' limit (a review found both left out)."""
-    rng = np.random.default_rng(1)
-    n = 800
-    u = rng.uniform(-1, 1, n)
-    y = np.zeros(n)
-    for k in range(2, n):
-        y[k] = 1.5 * y[k - 1] - 0.7 * y[k - 2] - 0.2 * y[k - 1] ** 3 + 0.5 * u[k - 1]
-    path = tmp_path / "d.csv"
-    write_csv(path, {"u": u, "y": y})
+    path = _duffing_csv(tmp_path / "d.csv", 800, seed=1)
     base = ["identify", str(path), "--input", "u", "--output", "y", "--na", "2", "--nb", "1", "--nk", "1",
             "--segmentation", "threshold"]
     assert main([*base, "--regions", "2", "--output-powers", "2", "--partition-column", "((y(k-1)-c)/s)^2",
