@@ -255,3 +255,31 @@ def test_property_power_terms_do_not_depend_on_the_data_units(scale, shift, seed
     one = ref.predict(u, y)
     np.testing.assert_allclose(moved.predict(u, scale * y + offset), scale * one + offset,
                                rtol=1e-7, atol=1e-7 * scale * np.std(y))
+
+
+@pytest.mark.parametrize("powered, chosen", [(90.3, ()), (91.0, (2, 3))])
+def test_the_powers_must_beat_the_affine_pieces(monkeypatch, powered, chosen):
+    """Made-up block fits: 2 threshold regions score 90 % on every block; the ARX model with the
+    powers ties them (90.3 %, within the tolerance) or beats them (91 %). A tie keeps the affine
+    pieces although the powered model has fewer regions and parameters (on a draining tank the
+    cubic tied the pieces on the blocks and extrapolated 2.8 points worse); a gain takes the powers."""
+    from hwpts.identification.selection import search as S
+
+    def scored(estimator, params, u, y, splits, prune_below=-np.inf, names=None, output_name=None, leader=None,
+               one_step=False, best_row=None):
+        if params.get("output_powers"):
+            free = powered if params["n_regions"] == 1 else powered - 5.0
+        else:
+            free = {1: 60.0, 2: 90.0}.get(params["n_regions"], 85.0)
+        k = len(splits)
+        return {"params": params, "split_fits_percent": [free] * k, "mean_fit_percent": free, "diverged": False,
+                "pruned": False, "error": None, "n_regions_fitted": params["n_regions"], "fit_time_s": 0.0,
+                "mean_one_step_fit_percent": 99.0, "split_one_step_fits_percent": [99.0] * k}
+
+    monkeypatch.setattr(S, "_evaluate", scored)
+    u, y = duffing(600, 9)
+    # the refit on all data is real, its block fits are not the made-up ones: no refit check
+    search = PWARXSearch(PWARX(2, 1, 1, random_state=0), methods=("threshold",), try_polish=False,
+                         refit_margin=1000.0).fit(u, y)
+    assert search.best_params_.get("output_powers", ()) == chosen
+    assert search.best_params_["n_regions"] == (1 if chosen else 2)

@@ -54,8 +54,9 @@ Two ways to say what to try:
      choice (step 5) would take so far, and, when that ARX model is not pruned, the model itself,
      are also scored with the power terms ``((y(k-1) - c) / s)^p``, ``p`` in :data:`POWER_TERMS`
      (a polynomial term in every mode: a smooth nonlinearity of the output, such as a cubic
-     spring, that affine pieces only approximate and cannot extrapolate); they compete in the
-     choice as any candidate, their two parameters a mode counted;
+     spring, that affine pieces only approximate and cannot extrapolate); in the choice they come
+     after every affine model: they must beat the affine pieces, as the polish must beat the
+     model it polishes;
   5. **choice**: the best score wins, but a candidate with fewer regions (then fewer parameters)
      is preferred unless the best *beats* it: by more than ``tolerance`` points and by more than
      ``n_standard_errors`` standard errors of their block-by-block differences (that term at most
@@ -942,7 +943,10 @@ class PWARXSearch(BaseEstimator):
             raise IdentificationError("every candidate model diverged in free run or failed: " + "; ".join(reasons))
         best = max(ok, key=self._score)
         near = [r for r in ok if not self._beats(best, r)]
-        near.sort(key=lambda r: (r["n_regions_fitted"] or 1,
+        # the output powers after every affine model: they must beat the affine pieces, as the
+        # polish must beat the model it polishes (a cubic and a few pieces can tie on the blocks
+        # and part beyond the training range, where the cubic bends away)
+        near.sort(key=lambda r: (bool(r["params"].get("output_powers")), r["n_regions_fitted"] or 1,
                                  self._n_params(base, r["params"], u.shape[1]), -self._score(r)))
         rest = sorted((r for r in ok if r not in near), key=lambda r: -self._score(r))
         return near + rest
