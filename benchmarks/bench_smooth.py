@@ -27,7 +27,7 @@ import warnings
 
 import numpy as np
 
-from benchmarks.bench_unseen import chosen_label, seeds_and_systems
+from benchmarks.bench_unseen import cell, chosen_label, seeds_and_systems
 
 NOISE = 0.02
 N_TRAIN, N_VALID = 2000, 3000
@@ -111,10 +111,6 @@ def main(argv=None) -> int:
     print(f"free-run fit % on noise-free data, median [min, max] over {n_seeds} seed(s); {N_TRAIN} training "
           f"samples, noise {NOISE:.0%} of the output's std; extrapolation: inputs x{GROWTH}")
 
-    def cell(v):
-        v = np.asarray(v, float)
-        return f"{np.nanmedian(v):6.1f} [{np.nanmin(v):6.1f}, {np.nanmax(v):5.1f}]"
-
     print(f"{'system':15s} {'record':14s} {'hwpts':>23s} {'hwpts, no powers':>23s} {'ARX':>7s} {'search s':>8s}  "
           f"chosen (na/nb/nk method regions)")
     for name in names:
@@ -122,7 +118,8 @@ def main(argv=None) -> int:
         for label in ("validation", "extrapolation"):
             extra = (f"  ({100 * np.median(beyond):.0f} % of outputs beyond the training range)"
                      if label == "extrapolation" else f"{np.median(times):8.1f}  {'; '.join(chosen)}")
-            print(f"{name:15s} {label:14s} {cell(rows['hwpts', label]):>23s} {cell(rows['hwpts, no powers', label]):>23s} "
+            print(f"{name:15s} {label:14s} {cell(rows['hwpts', label], 6):>23s} "
+                  f"{cell(rows['hwpts, no powers', label], 6):>23s} "
                   f"{np.nanmedian(rows['ARX', label]):7.1f} {extra}", flush=True)
     return 0
 

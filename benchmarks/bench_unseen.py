@@ -177,6 +177,12 @@ def seeds_and_systems(argv, systems, label):
     return list(range(n_seeds)), names
 
 
+def cell(values, min_width: int = 5) -> str:
+    """``median [min, max]`` of fits over the seeds (``nan`` left out)."""
+    v = np.asarray(values, float)
+    return f"{np.nanmedian(v):6.1f} [{np.nanmin(v):{min_width}.1f}, {np.nanmax(v):5.1f}]"
+
+
 def main(argv=None) -> int:
     parsed = seeds_and_systems(list(argv or []), SYSTEMS, "unseen")
     if parsed is None:
@@ -189,11 +195,6 @@ def main(argv=None) -> int:
           f"{'search s':>8s}  chosen (na/nb/nk method regions)")
     for name in names:
         rows, chosen, times = run(name, seeds)
-
-        def cell(v):
-            v = np.asarray(v, float)
-            return f"{np.nanmedian(v):6.1f} [{np.nanmin(v):5.1f}, {np.nanmax(v):5.1f}]"
-
         oracle = cell(rows["oracle"]) + ("*" if SYSTEMS[name]["output_error"] else " ")
         print(f"{name:24s} {cell(rows['hwpts']):>22s} {cell(rows['hwpts, true orders']):>22s} {oracle:>22s} "
               f"{np.nanmedian(rows['ARX']):8.1f} {np.median(times):8.1f}  {'; '.join(chosen)}", flush=True)

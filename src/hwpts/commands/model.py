@@ -410,8 +410,9 @@ def cmd_identify(args) -> int:
 
     _check_signals(args.input, args.output)
     powers = _output_powers(args.output_powers)
+    given_powers = () if powers == "auto" else powers  # the model's own; "auto" leaves them to the search
     fixed, searched = _orders_to_search(args)
-    if powers not in ("auto", ()) and fixed.get("output_order") == 0:
+    if given_powers and fixed.get("output_order") == 0:
         raise ParameterError(f"--output-powers {args.output_powers}: the power terms are of y(k-1), which --na 0 "
                              f"leaves out of the regressor; give --na >= 1 or --output-powers none")
     count = getattr(SEGMENTATION_METHODS.get(args.segmentation), "fixed_regions", None)
@@ -428,11 +429,11 @@ def cmd_identify(args) -> int:
         delays = estimate_delays(data.inputs, data.output)
         searched["input_delay"] = delay_candidates(delays)
     # after the delays: "u(k-5)" names a column then; a power term is a column when --output-powers gives it
-    _check_partition_columns(args, fixed, searched, () if powers == "auto" else powers)
+    _check_partition_columns(args, fixed, searched, given_powers)
     if not searched:
         structure = RegressorStructure.create(fixed["output_order"], fixed["input_order"], fixed["input_delay"],
                                               len(args.input), True, args.input, args.output,
-                                              () if powers == "auto" else powers)
+                                              given_powers)
         structure.check_length(data.n_samples, what=_selection(args, str(args.data)))
     hyperplanes = [Hyperplane.parse(h) for h in args.hyperplane]
     segmentation = args.segmentation
@@ -456,7 +457,7 @@ def cmd_identify(args) -> int:
     if segmentation not in ("hyperplane", "average", "zscore"):
         _check_region_count(n_regions, data.n_samples, fixed, searched, len(args.input),
                             searching=bool(searched) or segmentation == "auto",
-                            powers=() if powers == "auto" else powers)
+                            powers=given_powers)
     region_models = None
     if args.zero_region:
         n_hyper = len(hyperplanes) + 1 if segmentation == "hyperplane" else n_regions
@@ -475,7 +476,7 @@ def cmd_identify(args) -> int:
         hyperplanes=hyperplanes or None, region_models=region_models,
         ridge=args.ridge, polish=args.polish, random_state=args.seed,
         partition_columns=args.partition_column or None, sparse_partition=not args.all_partition_columns,
-        output_powers=() if powers == "auto" else powers,
+        output_powers=given_powers,
     )
     search = None
     # the search scores the winner with the polish too, unless --polish already polishes every candidate

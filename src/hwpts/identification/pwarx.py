@@ -33,7 +33,7 @@ from hwpts.identification.partition import (
     drop_empty_regions,
     fit_linear_partition,
 )
-from hwpts.identification.regressors import RegressorStructure, dense_real, validate_signals
+from hwpts.identification.regressors import RegressorStructure, dense_real, power_scaling, validate_signals
 from hwpts.identification.segmentation import make_segmenter
 from hwpts.identification.simulation import SimulationResult, k_step_pwarx, one_step_pwarx, simulate_pwarx
 from hwpts.identification.statespace import mode_state_space
@@ -252,7 +252,7 @@ class PWARX(BaseEstimator):
         names = tuple(names) if names is not None else tuple(f"u{j + 1}" for j in range(n_inputs))
         structure = RegressorStructure.create(self.output_order, self.input_order, self.input_delay,
                                               n_inputs, self.constant, names, oname or "y", self.output_powers,
-                                              float(np.mean(yy)), float(np.std(yy)) or 1.0)
+                                              *power_scaling(yy))
         structure.check_length(yy.shape[0])
         for j, name in enumerate(names):
             if structure.nb[j] > 0 and np.ptp(u[:, j]) == 0:

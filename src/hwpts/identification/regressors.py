@@ -75,6 +75,13 @@ def check_output_powers(value) -> tuple[int, ...]:
     return tuple(sorted(int(v) for v in items))
 
 
+def power_scaling(output) -> tuple[float, float]:
+    """``(c, s)`` of the power terms for a training ``output``: its mean and standard deviation
+    (1 for a constant output)."""
+    y = np.asarray(output, dtype=float)
+    return float(np.mean(y)), float(np.std(y)) or 1.0
+
+
 @dataclass(frozen=True)
 class RegressorStructure:
     """Orders of a MISO ARX structure and the names of its signals.
@@ -94,7 +101,8 @@ class RegressorStructure:
         Powers ``p >= 2`` of the standardised last output ``((y(k-1) - c) / s)^p`` appended to
         ``x_k`` (module doc); empty (the default): the paper's affine regressor.
     power_center, power_scale : float
-        ``c`` and ``s`` of those terms (the training output's mean and standard deviation).
+        ``c`` and ``s`` of those terms (the training output's mean and standard deviation,
+        :func:`power_scaling`); 0 and 1 without power terms.
     """
 
     na: int
@@ -128,7 +136,7 @@ class RegressorStructure:
         if powers and na < 1:
             raise ParameterError(f"output_powers {list(powers)} need y(k-1) in the regressor: na (output order) "
                                  f"must be >= 1, got {na}")
-        center, scale = float(power_center), float(power_scale)
+        center, scale = (float(power_center), float(power_scale)) if powers else (0.0, 1.0)
         if not (np.isfinite(center) and np.isfinite(scale) and scale > 0):
             raise ParameterError(f"power_center must be finite and power_scale finite and > 0, got "
                                  f"{power_center!r} and {power_scale!r}")

@@ -122,11 +122,11 @@ MODES_GATE = (0.25, 10.0, 0.5)
 # a ranking by noise); the four real records 58.4-99.3 / 90.1-100, where the ARX ranking stands
 NEIGHBOUR_GATE = 10.0
 SCORINGS = ("auto", "free_run", "one_step")
-# output_powers="auto": the powers of the standardised last output the adaptive search tries on the
-# leader and on its orders' ARX model (a square for asymmetry, a cube for a hardening or softening
-# spring: the polynomial NARX of the Silverbox literature is of degree 3)
+# output_powers="auto": the powers of the standardised last output the adaptive search tries (module
+# doc, step 4; a square for asymmetry, a cube for a hardening or softening spring: the polynomial
+# NARX of the Silverbox literature is of degree 3)
 POWER_TERMS = (2, 3)
-# the choice (module doc, step 4): a more complex candidate, or the polish, must beat the simpler
+# the choice (module doc, step 5): a more complex candidate, or the polish, must beat the simpler
 # one by ``tolerance`` and by ``n_standard_errors`` standard errors of the paired block differences,
 # that term capped at SE_CAP points. Measured (selection rules replayed on the searches' own
 # candidate tables, each candidate refitted and scored on noise-free validation or the test
@@ -729,9 +729,8 @@ class PWARXSearch(BaseEstimator):
     def _powers_stage(self, base, table, u, y, splits, bar):
         """Rows of the single ARX model of the orders of the model the choice would take so far
         (:meth:`_preference`) and, when that one is raced to the end, of the model itself, with the
-        power terms
-        (module doc, step 4); none when there are no powers to try, the estimator has its own, or
-        the leader has no output lag."""
+        power terms (module doc, step 4); none when there are no powers to try, the estimator has
+        its own, or that model has no output lag."""
         from hwpts.identification.regressors import check_output_powers
 
         if not self._powers or check_output_powers(base.output_powers):
@@ -850,15 +849,14 @@ class PWARXSearch(BaseEstimator):
         fit is :data:`MODES_GATE` [1] points above it, and whose misfit is under
         :data:`MODES_GATE` [2] of ``K - 1`` models' (a model that finds modes, not one more that
         fits the noise)."""
-        from hwpts.identification.regressors import RegressorStructure
+        from hwpts.identification.regressors import RegressorStructure, power_scaling
         from hwpts.identification.segmentation.switched import switched_fit_percent
 
         fits = {}
         if best_one > 100.0 - MODES_GATE[1]:  # no fit can be MODES_GATE[1] points above it
             return {"open": False, "modes": None, "switched_fits_percent": fits, "best_one_step": best_one}
         structure = RegressorStructure.create(*self._orders_of(base, orders), u.shape[1], base.constant,
-                                              output_powers=base.output_powers, power_center=float(np.mean(y)),
-                                              power_scale=float(np.std(y)) or 1.0)
+                                              None, None, base.output_powers, *power_scaling(y))
         X, t = structure.build(u, y)
         seed = base.random_state if isinstance(base.random_state, (int, np.integer)) else 0
         for k in range(1, top + 1):
