@@ -235,8 +235,13 @@ def test_property_compiled_free_run_matches_the_reference_loop(na, nb, powers, s
     y0 = rng.normal(size=st_.max_lag)
     part = RegionPartition.single(st_.n_features)
     sim = simulate_pwarx(st_, part, theta, u, y0, 0.0, 1e6)
-    ref, _ = simulate_true_pwarx(st_, part, theta, u, np.zeros(200), y0)
-    if not sim.diverged:
+    with np.errstate(over="ignore", invalid="ignore"):  # the reference runs on past a divergence
+        ref, _ = simulate_true_pwarx(st_, part, theta, u, np.zeros(200), y0)
+    if sim.diverged:  # (about 4 % of these draws) the reference leaves the band at the same sample
+        k = sim.diverged_at
+        assert not abs(ref[k]) <= 1e6
+        np.testing.assert_allclose(sim.output[:k], ref[:k], rtol=1e-9, atol=1e-9)
+    else:
         np.testing.assert_allclose(sim.output, ref, rtol=1e-9, atol=1e-9)
 
 
