@@ -24,6 +24,9 @@ def _pair(y, yhat):
         raise DataError(f"measured and predicted outputs differ in length: {y.size} vs {yhat.size}")
     if y.size == 0:
         raise DataError("cannot score an empty signal")
+    if not np.all(np.isfinite(y)):
+        raise DataError(f"the measured output has {int(np.sum(~np.isfinite(y)))} non-finite value(s) "
+                        f"(NaN or inf); a score needs every measured sample")
     return y, yhat
 
 

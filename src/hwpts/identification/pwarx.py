@@ -209,6 +209,25 @@ class PWARX(BaseEstimator):
         u, yy = validate_signals(_as_array(X), _output_vector(y))
         return u, yy, names, output_name
 
+    def _check_settings(self):
+        """One line naming the setting, what it takes and what it got, before any fit (the orders,
+        regions and rows are checked where they are used)."""
+        for name in ("constant", "polish", "sparse_partition"):
+            if not isinstance(getattr(self, name), (bool, np.bool_)):
+                raise ParameterError(f"{name} must be True or False, got {getattr(self, name)!r}")
+        for name, strict in (("ridge", False), ("classifier_C", True)):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+                    or not np.isfinite(value) or value < 0 or (strict and value == 0):
+                raise ParameterError(f"{name} must be a number {'> 0' if strict else '>= 0'}, got {value!r}")
+        rounds = self.refinement_rounds
+        if isinstance(rounds, bool) or not isinstance(rounds, (int, np.integer)) or rounds < 0:
+            raise ParameterError(f"refinement_rounds must be an int >= 0, got {rounds!r}")
+        seed = self.random_state
+        if not (seed is None or isinstance(seed, np.random.Generator)
+                or (isinstance(seed, (int, np.integer)) and not isinstance(seed, bool) and seed >= 0)):
+            raise ParameterError(f"random_state must be None or an int >= 0, got {seed!r}")
+
     def _segmenter(self):
         from sklearn.base import clone
 
@@ -247,9 +266,12 @@ class PWARX(BaseEstimator):
         if sample_time is not None and (isinstance(sample_time, bool) or not np.isfinite(sample_time)
                                         or sample_time <= 0):
             raise ParameterError(f"sample_time must be a positive number of seconds or None, got {sample_time!r}")
+        self._check_settings()
         u, yy, names, oname = self._signals(X, y, input_names, output_name)
         n_inputs = u.shape[1]
         names = tuple(names) if names is not None else tuple(f"u{j + 1}" for j in range(n_inputs))
+        _check_names(names, oname or "y", n_inputs)
+        breaks = _check_breaks(breaks, yy.shape[0])
         structure = RegressorStructure.create(self.output_order, self.input_order, self.input_delay,
                                               n_inputs, self.constant, names, oname or "y", self.output_powers,
                                               *power_scaling(yy))
@@ -437,6 +459,7 @@ class PWARX(BaseEstimator):
         The first ``max_lag`` outputs are the initial conditions, taken from ``initial_output`` or
         from the measured ``y``. Numba-compiled: about 10^7 samples per second.
         """
+        check_is_fitted(self, "theta_")
         m = self.structure_.max_lag
         if initial_output is not None:
             u, _ = self._check_inputs(X, None, need_y=False)
@@ -446,7 +469,7 @@ class PWARX(BaseEstimator):
         else:
             u, yy = self._check_inputs(X, y, need_y=m > 0)
             y0 = np.zeros(m) if yy is None else yy
-        if y0.shape[0] < m and u.shape[0] > m:
+        if y0.shape[0] < min(m, u.shape[0]) or (initial_output is not None and y0.shape[0] < m):
             raise DataError(f"need {m} initial outputs, got {y0.shape[0]}")
         center, half = self.divergence_band()
         return simulate_pwarx(self.structure_, self.partition_, self.theta_, u, y0, center, half)
@@ -545,6 +568,35 @@ class PWARX(BaseEstimator):
         est.sample_time_ = None
         est.units_ = {}
         return est
+
+
+def _check_names(names, output_name, n_inputs):
+    """The inputs' names: one per input column, distinct, none the output's (a regressor column is
+    chosen by name: ``partition_columns``, ``--partition-column``, the model file)."""
+    if len(names) != n_inputs:
+        raise ParameterError(f"input_names has {len(names)} names for {n_inputs} input columns: {list(names)}")
+    seen = set()
+    for name in names:
+        if not isinstance(name, str) or not name:
+            raise ParameterError(f"input names must be non-empty strings, got {name!r}")
+        if name in seen or name == output_name:
+            clash = "the output's name" if name == output_name else "two inputs' name"
+            raise ParameterError(f"input name {name!r} is {clash}; the names must be distinct (rename the columns)")
+        seen.add(name)
+
+
+def _check_breaks(breaks, n):
+    """``breaks`` as a sorted tuple of sample positions inside ``(0, n)`` (None or empty: none)."""
+    if breaks is None:
+        return ()
+    if isinstance(breaks, (str, bytes)) or not hasattr(breaks, "__iter__"):
+        raise ParameterError(f"breaks must be a list of sample positions, got {breaks!r}")
+    out = []
+    for b in breaks:
+        if isinstance(b, bool) or not isinstance(b, (int, np.integer)) or not 0 < b < n:
+            raise ParameterError(f"breaks must be sample positions between 1 and {n - 1}, got {b!r}")
+        out.append(int(b))
+    return tuple(sorted(set(out)))
 
 
 def _column_names(X) -> tuple[str, ...] | None:

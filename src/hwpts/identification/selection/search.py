@@ -550,10 +550,7 @@ class PWARXSearch(BaseEstimator):
         u, yy, names, oname = base._signals(X, y, input_names, output_name)
         self._names = (names, oname)
         n = yy.shape[0]
-        for name in ("tolerance", "n_standard_errors"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not value >= 0:
-                raise ParameterError(f"PWARXSearch: {name} must be a number >= 0, got {value!r}")
+        self._check_params()
         if not isinstance(self.scoring, str) or self.scoring not in SCORINGS:
             raise ParameterError(f"PWARXSearch: scoring must be one of {list(SCORINGS)}, got {self.scoring!r}")
         # "auto" is decided after the ARX stage of the adaptive search; until then the free run ranks
@@ -637,9 +634,7 @@ class PWARXSearch(BaseEstimator):
             keep = order_grid
             table.extend(self._run(base, [{**order_grid[0], **arx}], u, y, splits, "regions", bar))
             self._decide_scoring(table)
-        methods = tuple(self.methods)
-        if not methods:
-            raise ParameterError("PWARXSearch: methods leaves nothing to try")
+        methods = self._methods()
         survivors = list(methods)
         for number, orders in enumerate(keep):
             best, best_one = self._bests(table, orders)
@@ -711,6 +706,60 @@ class PWARXSearch(BaseEstimator):
         table.extend(self._modes_stage(base, table, u, y, splits, bar))
         table.extend(self._powers_stage(base, table, u, y, splits, bar))
         return table
+
+    def _methods(self) -> tuple:
+        """The segmentation methods to race: names of
+        :data:`~hwpts.identification.segmentation.SEGMENTATION_METHODS` or segmenter instances
+        (one name alone is one method, not its letters)."""
+        from hwpts.identification.segmentation import SEGMENTATION_METHODS, Segmenter
+
+        methods = (self.methods,) if isinstance(self.methods, (str, Segmenter)) else self.methods
+        try:
+            methods = tuple(methods)
+        except TypeError:
+            raise ParameterError(f"PWARXSearch: methods must be a list of segmentation names, "
+                                 f"got {self.methods!r}") from None
+        for method in methods:
+            if isinstance(method, Segmenter):
+                continue
+            if not isinstance(method, str) or method not in SEGMENTATION_METHODS:
+                raise ParameterError(f"PWARXSearch: methods has {method!r}; valid are {sorted(SEGMENTATION_METHODS)} "
+                                     f"or segmenter instances")
+        if not methods:
+            raise ParameterError("PWARXSearch: methods leaves nothing to try")
+        return methods
+
+    def _check_params(self):
+        """One line naming the parameter, what it takes and what it got, before any fit."""
+        def number(value, low, strict=False):
+            return (not isinstance(value, bool) and isinstance(value, (int, float, np.integer, np.floating))
+                    and np.isfinite(value) and (value > low if strict else value >= low))
+
+        def count(value, low):
+            return not isinstance(value, bool) and isinstance(value, (int, np.integer)) and value >= low
+
+        for name in ("tolerance", "n_standard_errors", "refit_margin"):
+            value = getattr(self, name)
+            if not number(value, 0):
+                raise ParameterError(f"PWARXSearch: {name} must be a number >= 0, got {value!r}")
+        for name, low in (("n_orders", 1), ("patience", 1)):
+            if not count(getattr(self, name), low):
+                raise ParameterError(f"PWARXSearch: {name} must be an int >= {low}, got {getattr(self, name)!r}")
+        if self.max_regions != "auto" and not count(self.max_regions, 1):
+            raise ParameterError(f"PWARXSearch: max_regions must be 'auto' or an int >= 1, got {self.max_regions!r}")
+        if not (isinstance(self.try_polish, (bool, np.bool_)) or (isinstance(self.try_polish, str)
+                                                                    and self.try_polish == "auto")):
+            raise ParameterError(f"PWARXSearch: try_polish must be True, False or 'auto', got {self.try_polish!r}")
+        if not isinstance(self.progress, (bool, np.bool_)):
+            raise ParameterError(f"PWARXSearch: progress must be True or False, got {self.progress!r}")
+        cv = self.cv
+        if not (cv is None or count(cv, 2) or (hasattr(cv, "split") and not isinstance(cv, (str, bytes)))):
+            raise ParameterError(f"PWARXSearch: cv must be None, an int >= 2 (blocks) or a splitter with split(), "
+                                 f"got {cv!r}")
+        if self.n_jobs is not None and (isinstance(self.n_jobs, bool) or not isinstance(self.n_jobs, (int, np.integer))
+                                        or self.n_jobs == 0):
+            raise ParameterError(f"PWARXSearch: n_jobs must be None or a non-zero int (-1: every core), got {self.n_jobs!r}")
+        self._methods()
 
     def _powers_to_try(self) -> tuple[int, ...]:
         """The power terms of the adaptive search's ``output_powers`` stage (validated)."""
@@ -793,7 +842,7 @@ class PWARXSearch(BaseEstimator):
         orders, when ``shared_modes`` says so: ``True`` always, ``"auto"`` when the gate opens
         (:meth:`_modes_gate`). The number of modes grows from the gate's count while the score or
         the one-step fit improves (``patience``), as in the region stage."""
-        if self.shared_modes is False or "switched" in tuple(self.methods):
+        if self.shared_modes is False or "switched" in self._methods():
             return []
         ok = [r for r in table if np.isfinite(self._score(r))]
         if not ok:

@@ -1,0 +1,114 @@
+"""Settings of the estimator and the search are checked before any fit: one ParameterError naming
+the setting, what it takes and what it got (never a misspelt method dropped in silence, a string
+read as True, or a library's own message about one of its internals)."""
+
+import numpy as np
+import pytest
+
+from hwpts.errors import DataError, ParameterError
+from hwpts.identification import PWARX, PWARXSearch, fit_percent
+
+
+def two_modes(n=600, seed=0):
+    rng = np.random.default_rng(seed)
+    u = rng.uniform(-1, 1, n)
+    y = np.zeros(n)
+    for k in range(1, n):
+        y[k] = 0.5 * y[k - 1] + u[k - 1] + 0.2 if y[k - 1] >= 0 else -0.4 * y[k - 1] + 2 * u[k - 1] - 0.1
+        y[k] += 0.01 * rng.standard_normal()
+    return u[:, None], y
+
+
+@pytest.mark.parametrize("setting, match", [
+    (dict(constant="no"), "constant must be True or False, got 'no'"),
+    (dict(polish="yes"), "polish must be True or False"),
+    (dict(sparse_partition="no"), "sparse_partition must be True or False"),
+    (dict(ridge="a"), "ridge must be a number >= 0, got 'a'"),
+    (dict(ridge=-1.0), "ridge must be a number >= 0"),
+    (dict(classifier_C=0), "classifier_C must be a number > 0, got 0"),
+    (dict(classifier_C=float("nan")), "classifier_C must be a number > 0"),
+    (dict(refinement_rounds=1.5), "refinement_rounds must be an int >= 0, got 1.5"),
+    (dict(refinement_rounds=-1), "refinement_rounds must be an int >= 0"),
+    (dict(random_state="a"), "random_state must be None or an int >= 0, got 'a'"),
+])
+def test_estimator_settings_are_checked(setting, match):
+    u, y = two_modes()
+    with pytest.raises(ParameterError, match=match):
+        PWARX(1, 1, 1, **setting).fit(u, y)
+
+
+@pytest.mark.parametrize("names, match", [
+    (["y"], "input name 'y' is the output's name"),
+    (["a", "a"], "input name 'a' is two inputs' name"),
+    (["a"], "input_names has 1 names for 2 input columns"),
+])
+def test_input_names_must_name_each_input_once(names, match):
+    u, y = two_modes()
+    u2 = np.column_stack([u[:, 0], u[::-1, 0]])
+    with pytest.raises(ParameterError, match=match):
+        PWARX(1, 1, 1).fit(u if names == ["y"] else u2, y, input_names=names)
+
+
+@pytest.mark.parametrize("breaks", ["300", [0], [600], [5000], [2.5]])
+def test_breaks_must_be_positions_inside_the_record(breaks):
+    u, y = two_modes()
+    with pytest.raises(ParameterError, match="breaks must be"):
+        PWARX(1, 1, 1).fit(u, y, breaks=breaks)
+
+
+def test_breaks_drop_the_rows_that_span_them():
+    u, y = two_modes()
+    whole = PWARX(1, 1, 1, segmentation="threshold", n_regions=2, random_state=0).fit(u, y)
+    split = PWARX(1, 1, 1, segmentation="threshold", n_regions=2, random_state=0).fit(u, y, breaks=[300, 300])
+    assert not np.allclose(whole.theta_, split.theta_)  # one row fewer, the same model nearly
+    np.testing.assert_allclose(whole.theta_, split.theta_, atol=0.05)
+
+
+@pytest.mark.parametrize("setting, match", [
+    (dict(methods=["treshold"]), "methods has 'treshold'; valid are"),
+    (dict(methods=[3]), "methods has 3"),
+    (dict(methods=[]), "methods leaves nothing to try"),
+    (dict(methods=5), "methods must be a list of segmentation names"),
+    (dict(max_regions=0), "max_regions must be 'auto' or an int >= 1, got 0"),
+    (dict(max_regions=2.5), "max_regions must be 'auto' or an int >= 1"),
+    (dict(patience=0), "patience must be an int >= 1, got 0"),
+    (dict(n_orders=1.5), "n_orders must be an int >= 1"),
+    (dict(refit_margin=float("nan")), "refit_margin must be a number >= 0, got nan"),
+    (dict(refit_margin=-1), "refit_margin must be a number >= 0"),
+    (dict(tolerance=-0.1), "tolerance must be a number >= 0"),
+    (dict(try_polish="no"), "try_polish must be True, False or 'auto', got 'no'"),
+    (dict(try_polish=1), "try_polish must be True, False or 'auto'"),
+    (dict(progress="yes"), "progress must be True or False"),
+    (dict(cv="a"), "cv must be None, an int >= 2"),
+    (dict(cv=1), "cv must be None, an int >= 2"),
+    (dict(n_jobs=0), "n_jobs must be None or a non-zero int"),
+])
+def test_search_settings_are_checked(setting, match):
+    u, y = two_modes()
+    with pytest.raises(ParameterError, match=match):
+        PWARXSearch(PWARX(1, 1, 1, random_state=0), **setting).fit(u, y)
+
+
+def test_one_method_name_is_one_method():
+    u, y = two_modes()
+    search = PWARXSearch(PWARX(1, 1, 1, random_state=0), methods="threshold", shared_modes=False,
+                         output_powers=None).fit(u, y)
+    tried = {r["params"].get("segmentation") for r in search.cv_results_}
+    assert tried <= {"average", "threshold"} and "threshold" in tried
+    assert all(r["error"] is None for r in search.cv_results_)
+
+
+def test_simulate_before_fit_and_short_initial_outputs():
+    u, y = two_modes()
+    with pytest.raises(Exception, match="not fitted"):
+        PWARX().simulate(u, y)
+    model = PWARX(2, 1, 1, segmentation="threshold", n_regions=2, random_state=0).fit(u, y)
+    with pytest.raises(DataError, match="need 2 initial outputs, got 1"):
+        model.simulate(u[:2], initial_output=[0.1])  # not broadcast into both lags
+    np.testing.assert_array_equal(model.simulate(u[:2], initial_output=[0.1, 0.2]).output, [0.1, 0.2])
+
+
+def test_a_score_against_a_measured_nan_is_an_error():
+    with pytest.raises(DataError, match="1 non-finite value"):
+        fit_percent([1.0, np.nan, 3.0], [1.0, 2.0, 3.0])
+    assert np.isnan(fit_percent([1.0, 2.0, 3.0], [1.0, np.nan, 3.0]))  # a diverged prediction
