@@ -99,6 +99,22 @@ class IODataset:
             return float("nan")
         return float(np.median(np.diff(self.time)))
 
+    def uniform_sample_time(self, what: str = "the time column") -> float | None:
+        """The sample period [s] when the time axis is uniform (every step within 1 % of the
+        median; ``None`` for fewer than two samples), else a :class:`DataError` naming the first
+        row where it is not: lagged regressors across a gap or a jitter mean other delays."""
+        if self.n_samples < 2:
+            return None
+        steps = np.diff(self.time)
+        dt = float(f"{float(np.median(steps)):.12g}")  # 0.01, not 0.009999999999999787 from the time column's rounding
+        worst = float(np.max(np.abs(steps - dt)))
+        if worst > 0.01 * dt:
+            row = int(np.argmax(np.abs(steps - dt))) + 1
+            raise DataError(f"{what} is not uniformly sampled (step {dt:.6g} s, but {steps[row - 1]:.6g} s at row "
+                            f"{row}); PWARX models need a constant sample time: resample, or fit the stretches "
+                            f"as one record with breaks at the gaps")
+        return dt
+
     def input(self, name: str) -> np.ndarray:
         """One input column by name."""
         try:

@@ -112,3 +112,23 @@ def test_a_score_against_a_measured_nan_is_an_error():
     with pytest.raises(DataError, match="1 non-finite value"):
         fit_percent([1.0, np.nan, 3.0], [1.0, 2.0, 3.0])
     assert np.isnan(fit_percent([1.0, 2.0, 3.0], [1.0, np.nan, 3.0]))  # a diverged prediction
+
+
+@pytest.mark.parametrize("shift", ["gap", "jitter"])
+def test_a_dataset_with_a_gap_or_jitter_in_time_is_refused(shift):
+    from hwpts.dataset import IODataset
+
+    u, y = two_modes(1000)
+    t = np.arange(1000) * 0.01
+    if shift == "gap":
+        t[500:] += 50.0  # two experiments joined: a row spanning the gap would mix them
+    else:
+        t = t + np.random.default_rng(1).uniform(-0.004, 0.004, 1000)
+    data = IODataset(t, u, y, ["u"], "y")
+    with pytest.raises(DataError, match="the dataset's time is not uniformly sampled"):
+        PWARX(1, 1, 1).fit(data)
+    with pytest.raises(DataError, match="not uniformly sampled"):
+        PWARXSearch(PWARX(1, 1, 1), methods="threshold").fit(data)
+    model = PWARX(1, 1, 1, segmentation="threshold", random_state=0).fit(u, y, breaks=[500] if shift == "gap" else None)
+    with pytest.raises(DataError, match="not uniformly sampled"):
+        model.simulate(data)

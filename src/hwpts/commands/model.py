@@ -129,16 +129,7 @@ def _selection(args, name: str) -> str:
 
 def _sample_time(data, path, tname) -> float | None:
     """The data's sample period [s] from its time column; a non-uniform time axis is refused."""
-    if data.n_samples < 2:
-        return None
-    steps = np.diff(data.time)
-    dt = float(f"{float(np.median(steps)):.12g}")  # 0.01, not 0.009999999999999787 from the time column's rounding
-    worst = float(np.max(np.abs(steps - dt)))
-    if worst > 0.01 * dt:
-        row = int(np.argmax(np.abs(steps - dt))) + 1
-        raise DataError(f"{str(path)!r}: the time column {tname!r} is not uniformly sampled (step {dt:.6g} s, "
-                        f"but {steps[row - 1]:.6g} s at row {row}); PWARX models need a constant sample time")
-    return dt
+    return data.uniform_sample_time(f"{str(path)!r}: the time column {tname!r}")
 
 
 SAMPLE_TIME_TOLERANCE = 0.01  # relative difference of sample times treated as equal

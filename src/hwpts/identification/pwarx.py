@@ -261,8 +261,10 @@ class PWARX(BaseEstimator):
         given); kept in the model so that data at another rate are refused. ``units``: optional
         ``{signal name: unit}`` kept for plots and exports. Returns ``self``.
         """
-        if sample_time is None and isinstance(X, IODataset) and X.n_samples > 1:
-            sample_time = X.sample_time
+        if isinstance(X, IODataset):
+            uniform = X.uniform_sample_time("the dataset's time")
+            if sample_time is None:
+                sample_time = uniform
         if sample_time is not None and (isinstance(sample_time, bool) or not np.isfinite(sample_time)
                                         or sample_time <= 0):
             raise ParameterError(f"sample_time must be a positive number of seconds or None, got {sample_time!r}")
@@ -395,6 +397,7 @@ class PWARX(BaseEstimator):
             if y is not None:
                 raise ParameterError("pass either an IODataset or (inputs, output), not both")
             known = getattr(self, "sample_time_", None)
+            X.uniform_sample_time("the dataset's time")
             if known is not None and X.n_samples > 1 and abs(X.sample_time - known) > 0.01 * known:
                 raise DataError(f"the data's sample time {X.sample_time:.6g} s differs from the model's {known:.6g} s: "
                                 f"its lags would mean other delays; resample the data or refit")

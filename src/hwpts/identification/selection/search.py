@@ -541,8 +541,10 @@ class PWARXSearch(BaseEstimator):
         """
         from hwpts.dataset import IODataset
 
-        if sample_time is None and isinstance(X, IODataset) and X.n_samples > 1:
-            sample_time = X.sample_time
+        if isinstance(X, IODataset):
+            uniform = X.uniform_sample_time("the dataset's time")
+            if sample_time is None:
+                sample_time = uniform
         if sample_time is not None and (isinstance(sample_time, bool) or not np.isfinite(sample_time)
                                         or sample_time <= 0):
             raise ParameterError(f"sample_time must be a positive number of seconds or None, got {sample_time!r}")
