@@ -132,3 +132,28 @@ def test_a_dataset_with_a_gap_or_jitter_in_time_is_refused(shift):
     model = PWARX(1, 1, 1, segmentation="threshold", random_state=0).fit(u, y, breaks=[500] if shift == "gap" else None)
     with pytest.raises(DataError, match="not uniformly sampled"):
         model.simulate(data)
+
+
+@pytest.mark.parametrize("method, params, match", [
+    ("alternating", {"gamma": float("nan")}, "alternating: gamma must be a number >= 0, got nan"),
+    ("alternating", {"n_restarts": 0}, "alternating: n_restarts must be an int >= 1 or 'auto', got 0"),
+    ("alternating", {"max_iter": 0}, "alternating: max_iter must be an int >= 1"),
+    ("alternating", {"anneal": (0,)}, "alternating: anneal must be a list of numbers > 0"),
+    ("clustering", {"n_neighbors": 1}, "clustering: n_neighbors must be an int >= 2, got 1"),
+    ("clustering", {"n_init": 0}, "clustering: n_init must be an int >= 1"),
+    ("kmeans", {"n_init": 2.5}, "kmeans: n_init must be an int >= 1"),
+    ("kmeans", {"include_output": "yes"}, "kmeans: include_output must be True or False"),
+])
+def test_segmenter_settings_are_checked(method, params, match):
+    u, y = two_modes()
+    with pytest.raises(ParameterError, match=match):
+        PWARX(1, 1, 1, segmentation=method, segmentation_params=params, random_state=0).fit(u, y)
+
+
+def test_one_partition_column_name_is_one_column_and_an_empty_simulation_is_refused():
+    u, y = two_modes()
+    one = PWARX(1, 1, 1, segmentation="alternating", partition_columns="y(k-1)", random_state=0).fit(u, y)
+    listed = PWARX(1, 1, 1, segmentation="alternating", partition_columns=["y(k-1)"], random_state=0).fit(u, y)
+    np.testing.assert_array_equal(one.theta_, listed.theta_)
+    with pytest.raises(DataError, match="at least one sample"):
+        one.simulate(u[:0], y[:0])

@@ -301,7 +301,9 @@ class PWARX(BaseEstimator):
                                 f"too few to fit")
         pcols = None
         if self.partition_columns is not None:
-            pcols = sorted({structure.column_index(c) for c in self.partition_columns})
+            wanted = self.partition_columns
+            wanted = (wanted,) if isinstance(wanted, str) else wanted  # one name is one column, not its letters
+            pcols = sorted({structure.column_index(c) for c in wanted})
         if segmenter.uses_n_regions and isinstance(self.n_regions, (int, np.integer)) \
                 and not isinstance(self.n_regions, bool) and self.n_regions > X_reg.shape[0] // (structure.n_features + 2):
             raise ParameterError(
@@ -472,6 +474,8 @@ class PWARX(BaseEstimator):
         else:
             u, yy = self._check_inputs(X, y, need_y=m > 0)
             y0 = np.zeros(m) if yy is None else yy
+        if u.shape[0] == 0:
+            raise DataError("simulate needs at least one sample of the inputs, got none")
         if y0.shape[0] < min(m, u.shape[0]) or (initial_output is not None and y0.shape[0] < m):
             raise DataError(f"need {m} initial outputs, got {y0.shape[0]}")
         center, half = self.divergence_band()

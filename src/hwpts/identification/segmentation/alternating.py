@@ -263,6 +263,16 @@ class AlternatingSegmenter(Segmenter):
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
         """Labels from alternating assignment and least squares with restarts (see the module docstring)."""
         self._check_regions(n_regions, X.shape[0])
+        self._check_count("n_restarts", 1, allow=("auto",))
+        self._check_number("gamma", 0.0)
+        self._check_count("max_iter", 1)
+        try:
+            anneal = tuple(float(a) for a in self.anneal)
+        except (TypeError, ValueError):
+            anneal = None
+        if anneal is None or not all(np.isfinite(a) and a > 0 for a in anneal):
+            raise ParameterError(f"alternating: anneal must be a list of numbers > 0 (multiples of gamma), "
+                                 f"got {self.anneal!r}")
         s = n_regions
         n = X.shape[0]
         if s == 1:

@@ -87,6 +87,9 @@ class ClusteringSegmenter(Segmenter):
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
         """Labels from clustering the local-model features of Ferrari-Trecate et al. (see the module docstring)."""
         self._check_regions(n_regions, X.shape[0])
+        if self.n_neighbors is not None:
+            self._check_count("n_neighbors", 2)
+        self._check_count("n_init", 1)
         p = X.shape[1] + 1
         c = self.n_neighbors if self.n_neighbors is not None else max(2 * p, p + 3)
         theta, m, V, c = local_features(X, y, c)

@@ -32,6 +32,8 @@ class KMeansSegmenter(Segmenter):
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
         """Labels from k-means on the standardised regressors."""
         self._check_regions(n_regions, X.shape[0])
+        self._check_count("n_init", 1)
+        self._check_bool("include_output")
         Z = standardize(np.column_stack([X, y]) if self.include_output else X)
         labels = kmeans_labels(Z, n_regions, rng, self.n_init)
         return SegmentationResult(labels, n_regions, refine=False)
