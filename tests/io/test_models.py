@@ -8,7 +8,7 @@ import pytest
 from hwpts.errors import DataError
 from hwpts.identification import PWARX
 from hwpts.identification.synthetic import make_system
-from hwpts.io.models import SCHEMA, checksum, load_model, save_model
+from hwpts.io.models import SCHEMA, checksum, load_model, model_from_dict, save_model
 
 
 @pytest.fixture(scope="module")
@@ -75,3 +75,29 @@ def test_not_json_and_missing(tmp_path):
         load_model(bad)
     with pytest.raises(DataError, match="no such file"):
         load_model(tmp_path / "absent.json")
+
+
+def test_a_loaded_model_refits_as_it_was_fitted(tmp_path):
+    """The file keeps the estimator's settings: clone(load_model(p)).fit(...) is the same fit."""
+    from sklearn.base import clone
+
+    from hwpts.identification import PWARX
+
+    rng = np.random.default_rng(0)
+    u = rng.uniform(-1, 1, 600)
+    y = np.zeros(600)
+    for k in range(1, 600):
+        y[k] = 0.5 * y[k - 1] + u[k - 1] + 0.2 if y[k - 1] >= 0 else -0.4 * y[k - 1] + 2 * u[k - 1] - 0.1
+    for model in (PWARX(1, 1, 1, segmentation="hyperplane", hyperplanes=["1,0@y(k-1)"], random_state=0),
+                  PWARX(1, 1, 1, segmentation="alternating", polish=True, random_state=3, ridge=1e-6,
+                        partition_columns=["y(k-1)"])):
+        model.fit(u[:, None], y)
+        save_model(model, tmp_path / "m.json")
+        loaded = load_model(tmp_path / "m.json")
+        for key in ("segmentation", "hyperplanes", "polish", "random_state", "ridge", "partition_columns"):
+            assert loaded.get_params()[key] == model.get_params()[key]
+        np.testing.assert_array_equal(clone(loaded).fit(u[:, None], y).theta_, model.theta_)
+    doc = json.loads((tmp_path / "m.json").read_text())
+    doc["settings"]["colour"] = "red"
+    with pytest.raises(DataError, match="settings has unknown keys"):
+        model_from_dict(doc)

@@ -44,6 +44,43 @@ def _jsonable(value):
     return value
 
 
+# the estimator's settings a model file keeps (the orders, constant and output powers are in its
+# structure), so that a loaded model refits as it was fitted (``clone(load_model(p)).fit(...)``)
+SETTINGS = ("segmentation", "n_regions", "hyperplanes", "region_models", "ridge", "refinement_rounds",
+            "classifier_C", "segmentation_params", "polish", "partition_columns", "sparse_partition",
+            "max_rows", "classifier_rows", "random_state")
+
+
+def _hyperplane_text(h) -> str:
+    """A hyperplane as the ``"a,b,c@col1,col2"`` text :meth:`Hyperplane.parse` reads (exact floats)."""
+    if isinstance(h, str):
+        return h
+    body = ",".join(repr(float(v)) for v in (*h.coefficients, h.offset))
+    return body if h.columns is None else body + "@" + ",".join(h.columns)
+
+
+def _settings(model) -> dict:
+    """The JSON-able settings of :data:`SETTINGS` (one that is not, e.g. a segmenter instance's
+    own object or a numpy Generator, is left out and keeps its default on loading)."""
+    params = model.get_params(deep=False)
+    out = {}
+    for key in SETTINGS:
+        value = params.get(key)
+        if key == "segmentation" and not isinstance(value, str):
+            value = getattr(value, "name", None)
+        elif key == "hyperplanes" and value is not None:
+            value = [_hyperplane_text(h) for h in value]
+        elif key == "random_state" and not (value is None or isinstance(value, (int, np.integer))):
+            continue
+        value = _jsonable(value)
+        try:
+            json.dumps(value, allow_nan=False)
+        except (TypeError, ValueError):
+            continue
+        out[key] = value
+    return out
+
+
 def checksum(doc: dict, sections=CHECKED_SECTIONS) -> str:
     """SHA-256 of the canonical JSON of the numeric sections (sorted keys, no spaces)."""
     payload = {k: doc.get(k) for k in sections}
@@ -86,6 +123,7 @@ def model_to_dict(model) -> dict:
             "units": dict(getattr(model, "units_", {}) or {}),
         },
         "segmentation": _jsonable({"method": model.summary()["segmentation"], **model.segmentation_info_}),
+        "settings": _settings(model),
     }
     doc["checksum"] = {"algorithm": "sha256", "sections": list(CHECKED_SECTIONS), "value": checksum(doc)}
     return doc
@@ -302,4 +340,11 @@ def model_from_dict(doc: dict):
     model.region_counts_ = np.array([int(r.get("n_train_samples", 0)) for r in regions], dtype=np.int64)
     if isinstance(seg, dict) and isinstance(seg.get("method"), str):
         model.segmentation = seg["method"]
+    settings = doc.get("settings", {})  # optional (files written before it refit with the defaults)
+    if not isinstance(settings, dict):
+        raise DataError(f"settings must be a JSON object, got {type(settings).__name__}")
+    unknown = sorted(set(settings) - set(SETTINGS))
+    if unknown:
+        raise DataError(f"settings has unknown keys {unknown}; valid are {list(SETTINGS)}")
+    model.set_params(**settings)
     return model
