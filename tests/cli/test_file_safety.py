@@ -406,3 +406,31 @@ def test_a_read_only_install_still_runs(tmp_path):
     finally:
         for path in [site, *site.rglob("*")]:
             os.chmod(path, 0o755 if path.is_dir() else 0o644)
+
+
+def test_a_summary_that_cannot_be_printed_leaves_no_model(tmp_path, monkeypatch, capsys):
+    """The summary is printed before the model file is committed: a full disk behind stdout
+    exits 2 with one line and writes no model (it was written, then the run said it failed)."""
+    import errno
+
+    from hwpts.identification.synthetic import make_system
+    from hwpts.io.datasets import write_csv
+
+    d = make_system(5, rng=0, n=300)
+    write_csv(tmp_path / "d.csv", {"u1": d.inputs[:, 0], "u2": d.inputs[:, 1], "y": d.output})
+
+    class Full:
+        def write(self, text):
+            raise OSError(errno.ENOSPC, "No space left on device")
+
+        def flush(self):
+            pass
+
+    monkeypatch.setattr("sys.stdout", Full())
+    status = main(["identify", str(tmp_path / "d.csv"), "--input", "u1", "--input", "u2", "--output", "y",
+                   "--na", "2", "--nb", "2", "--segmentation", "average", "--out", str(tmp_path / "m.json")])
+    monkeypatch.undo()
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(err) == 1 and "standard output: cannot write the summary" in err[0]
+    assert not (tmp_path / "m.json").exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["d.csv"]

@@ -103,3 +103,21 @@ def test_only_the_named_columns_are_parsed(tmp_path):
     assert list(cols) == ["u", "y"]
     with pytest.raises(DataError, match="line 2, column 'date': expected a number, got '2026-11-22'"):
         read_table(path)
+
+
+def test_parquet_time_stamps_are_seconds_and_big_integers_are_read(tmp_path):
+    """A Parquet time stamp column is read in seconds whatever its unit (10 ms steps were read as
+    10 "seconds"); a CSV integer beyond 2^53 (a nanosecond epoch) is read as the nearest float
+    instead of raising pyarrow's range error; duplicate Parquet names are one line."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    ticks = (np.arange(5) * 10).astype("datetime64[ms]")
+    pq.write_table(pa.table({"t": pa.array(ticks), "y": np.arange(5.0)}), tmp_path / "ts.parquet")
+    np.testing.assert_allclose(read_table(tmp_path / "ts.parquet")["t"], np.arange(5) * 0.01)
+    (tmp_path / "ns.csv").write_text("t,y\n" + "".join(f"{1700000000000000000 + i * 10**9},{i}\n" for i in range(5)))
+    t = read_table(tmp_path / "ns.csv")["t"]
+    np.testing.assert_allclose(np.diff(t), 1e9)
+    pq.write_table(pa.table({"a": np.ones(3), "b": np.ones(3)}).rename_columns(["u", "u"]), tmp_path / "dup.parquet")
+    with pytest.raises(DataError, match=r"duplicate column name\(s\) \['u'\]"):
+        read_table(tmp_path / "dup.parquet")

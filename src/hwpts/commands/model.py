@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 import time
 import warnings
 
@@ -77,7 +78,7 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
     applied silently to data sampled at another rate; ``time_name="none"`` uses the row index.
     """
     from hwpts.dataset import IODataset
-    from hwpts.io.datasets import read_table
+    from hwpts.io.datasets import numeric_share, read_table
 
     signals = [*input_names, output_name]
     if time_name == NO_TIME:
@@ -92,12 +93,21 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
         if time_name is not None or not candidates:
             raise
         columns = read_table(path, signals)  # a conventionally named column that holds text is no time axis
+        for name in candidates:  # ... but one of numbers with a mistyped cell is a broken time axis
+            if numeric_share(path, name) >= 0.9:
+                read_table(path, [*signals, name])  # raises the cell's line and text
+                raise
     if time_name not in (None, NO_TIME) and time_name not in columns:
         raise DataError(f"{str(path)!r}: no time column {time_name!r}; {_available(path, columns)}")
     missing = [c for c in signals if c not in columns]
     if missing:
         raise DataError(f"{str(path)!r}: no column(s) {missing}; {_available(path, columns)}")
     sl = _rows(rows)
+    total = len(columns[output_name])
+    for end in (sl.start, sl.stop):
+        if end is not None and not -total <= end <= total:
+            raise ParameterError(f"--rows {rows}: {end} is beyond the file's {total} data rows "
+                                 f"(rows 0 to {total - 1}, or -{total} to -1 from the end)")
     cols = {k: np.asarray(v)[sl] for k, v in columns.items()}
     n = len(cols[output_name])
     if n == 0:
@@ -135,10 +145,17 @@ def _sample_time(data, path, tname) -> float | None:
 SAMPLE_TIME_TOLERANCE = 0.01  # relative difference of sample times treated as equal
 
 
+MAX_RESAMPLED = 20_000_000  # samples a resampled record may have (160 MB per signal)
+
+
 def _resampled(data, dt, model_dt):
     """``data`` linearly interpolated onto the model's sample time (``--resample``)."""
     from hwpts.dataset import IODataset
 
+    count = (data.time[-1] - data.time[0]) / model_dt + 1
+    if not count <= MAX_RESAMPLED:
+        raise DataError(f"--resample: the record spans {data.time[-1] - data.time[0]:.6g} s, {count:.3g} samples at the "
+                        f"model's {model_dt:.6g} s (at most {MAX_RESAMPLED:.0e}); is the time column in seconds?")
     t = np.arange(data.time[0], data.time[-1] + 0.5 * model_dt, model_dt)
     t = t[t <= data.time[-1] + 1e-12 * abs(data.time[-1])]
     inputs = np.column_stack([np.interp(t, data.time, data.inputs[:, j]) for j in range(data.inputs.shape[1])])
@@ -435,6 +452,9 @@ def cmd_identify(args) -> int:
         raise ParameterError("--segmentation hyperplane needs at least one --hyperplane \"a,b,c\"")
     if hyperplanes and segmentation != "hyperplane":
         raise ParameterError(f"--hyperplane needs --segmentation hyperplane, not {segmentation!r}")
+    if hyperplanes and args.regions != "auto" and str(args.regions).strip() != str(len(hyperplanes) + 1):
+        raise ParameterError(f"--regions {args.regions}: {len(hyperplanes)} --hyperplane make {len(hyperplanes) + 1} "
+                             f"regions (a decision list); leave --regions out")
     regions = args.regions
     if regions == "auto":
         n_regions = "auto"
@@ -514,8 +534,23 @@ def cmd_identify(args) -> int:
     notes = _warning_lines([w.message for w in caught if issubclass(w.category, UserWarning)])
     if notes:
         summary["warnings"] = notes
-    save_model(model, args.out)
-    print(json_text(summary))
+    text = json_text(summary) + "\n"
+    closed = []
+
+    def report():  # the summary is printed before the model file is committed: a run that cannot
+        # print it (a full disk behind stdout) or is stopped meanwhile leaves no file behind
+        try:
+            sys.stdout.write(text)
+            sys.stdout.flush()
+        except BrokenPipeError as error:  # the reader stopped early (| head): the model is still wanted
+            closed.append(error)
+        except OSError as error:
+            raise DataError(f"standard output: cannot write the summary ({error.strerror or error}); "
+                            f"{args.out} was not written") from None
+
+    save_model(model, args.out, before_commit=report)
+    if closed:
+        raise closed[0]  # handled as every command's closed pipe
     return 0
 
 

@@ -134,10 +134,14 @@ def atomic_path(path: str | os.PathLike, suffix: str | None = None):
         raise
 
 
-def write_text_atomic(path: str | os.PathLike, text: str) -> None:
-    """Write ``text`` to ``path`` atomically (UTF-8)."""
+def write_text_atomic(path: str | os.PathLike, text: str, before_commit=None) -> None:
+    """Write ``text`` to ``path`` atomically (UTF-8). ``before_commit()``, when given, runs once the
+    text is written and before the rename: if it fails (or the run is interrupted in it) ``path``
+    is left as it was (what a command prints about the file belongs there)."""
     with atomic_path(path) as tmp:
         tmp.write_text(text, encoding="utf-8")
+        if before_commit is not None:
+            before_commit()
 
 
 def write_bytes_atomic(path: str | os.PathLike, data: bytes) -> None:

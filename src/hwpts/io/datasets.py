@@ -102,8 +102,30 @@ def read_csv(path: str | os.PathLike, columns=None) -> dict[str, np.ndarray]:
         column = table.column(i)
         if not (pa.types.is_floating(column.type) or pa.types.is_integer(column.type) or pa.types.is_null(column.type)):
             return _read_csv_python(p, delimiter, columns)
-        out[name] = column.cast(pa.float64()).to_numpy(zero_copy_only=False)
+        # unsafe: an integer beyond 2^53 (a nanosecond epoch time) rounds to the nearest float
+        # instead of raising pyarrow's range error
+        out[name] = column.cast(pa.float64(), safe=False).to_numpy(zero_copy_only=False)
     return out
+
+
+def numeric_share(path: str | os.PathLike, column: str) -> float:
+    """The share of a CSV column's non-empty cells that read as numbers (0 for another format or
+    a file without that column): a time column of numbers with one mistyped cell (near 1) is a
+    broken time axis, a column of dates or labels (near 0) is not a time axis at all."""
+    p = Path(path)
+    if p.suffix.lower() != ".csv":
+        return 0.0
+    try:
+        text = p.read_text(encoding="utf-8-sig", errors="replace")
+    except OSError:
+        return 0.0
+    rows = [r for r in csv.reader(io.StringIO(text), delimiter=_sniff(p)) if any(c.strip() for c in r)]
+    header = [h.strip() for h in rows[0]] if rows else []
+    if column not in header:
+        return 0.0
+    j = header.index(column)
+    cells = [r[j].strip() for r in rows[1:] if j < len(r) and r[j].strip()]
+    return sum(is_number(c) and "_" not in c for c in cells) / len(cells) if cells else 0.0
 
 
 def is_number(text: str) -> bool:
@@ -153,6 +175,8 @@ def _read_csv_python(p: Path, delimiter: str = ",", columns=None) -> dict[str, n
         for j in wanted:
             cell = row[j]
             try:
+                if "_" in cell:  # Python's float() reads "1_000" as 1000; no CSV writer means that
+                    raise ValueError
                 values[i - 2, j] = float(cell)
             except ValueError:
                 raise DataError(
@@ -231,15 +255,29 @@ def _read_parquet(p: Path, columns=None) -> dict[str, np.ndarray]:
         import pyarrow.parquet as pq
     except ImportError:  # pragma: no cover - pyarrow is a dependency
         raise DataError("reading Parquet needs pyarrow; install pyarrow") from None
+    import pyarrow as pa
+
     try:
-        table = pq.read_table(p)
+        names = [str(n) for n in pq.read_schema(p).names]
+        dup = sorted({n for n in names if names.count(n) > 1})
+        table = None if dup else pq.read_table(p)
     except Exception as error:  # pyarrow raises several types for corrupt files
-        raise DataError(f"{str(p)!r}: not a readable Parquet file ({error})") from None
+        first = str(error).strip().splitlines()[0] if str(error).strip() else type(error).__name__
+        raise DataError(f"{str(p)!r}: not a readable Parquet file ({first})") from None
+    if dup:
+        raise DataError(f"{str(p)!r}: duplicate column name(s) {dup}")
     out = {}
-    for name in table.column_names:
+    for i, name in enumerate(names):
         if columns is not None and name not in columns:
             continue
-        col = table.column(name).to_numpy(zero_copy_only=False)
+        column = table.column(i)
+        if pa.types.is_timestamp(column.type) or pa.types.is_duration(column.type):
+            # a time stamp or duration is read in seconds, whatever its unit (not its raw count)
+            per_second = {"s": 1.0, "ms": 1e3, "us": 1e6, "ns": 1e9}[column.type.unit]
+            ticks = column.cast(pa.int64()).to_numpy(zero_copy_only=False)
+            out[name] = np.asarray(ticks, dtype=float) / per_second
+            continue
+        col = column.to_numpy(zero_copy_only=False)
         try:
             out[name] = np.asarray(col, dtype=float)
         except (TypeError, ValueError):

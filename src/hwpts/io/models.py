@@ -134,8 +134,9 @@ def dumps_model(model) -> str:
     return json.dumps(model_to_dict(model), indent=1, allow_nan=False) + "\n"
 
 
-def save_model(model, path: str | os.PathLike) -> None:
-    """Write the model file atomically (temporary file, then rename).
+def save_model(model, path: str | os.PathLike, before_commit=None) -> None:
+    """Write the model file atomically (temporary file, then rename); ``before_commit()`` runs
+    between the two (:func:`hwpts.io.atomic.write_text_atomic`).
 
     >>> import tempfile, pathlib, numpy as np
     >>> from hwpts.identification import PWARX
@@ -148,7 +149,7 @@ def save_model(model, path: str | os.PathLike) -> None:
     """
     from hwpts.io.atomic import write_text_atomic
 
-    write_text_atomic(path, dumps_model(model))
+    write_text_atomic(path, dumps_model(model), before_commit)
 
 
 def _reject_constant(token):

@@ -258,16 +258,24 @@ class Hyperplane:
 
         Without ``@``, the columns are the first inputs in order (``"a,c"`` uses the first input).
         """
-        body, _, cols = str(text).partition("@")
+        body, at, cols = str(text).partition("@")
+        fields = [v.strip() for v in body.split(",")]
         try:
-            numbers = [float(v) for v in body.split(",") if v.strip() != ""]
+            if any(not v or "_" in v for v in fields):  # an empty field would shift the others
+                raise ValueError
+            numbers = [float(v) for v in fields]
         except ValueError:
             raise ParameterError(
                 f"hyperplane {text!r}: expected numbers 'a,b,c' meaning a*x1 + b*x2 + c >= 0"
             ) from None
         if len(numbers) < 2:
             raise ParameterError(f"hyperplane {text!r}: expected at least 'a,c' (a*x1 + c >= 0)")
-        columns = [c.strip() for c in cols.split(",")] if cols else None
+        columns = [c.strip() for c in cols.split(",")] if at else None
+        if columns is not None:
+            if any(not c for c in columns):
+                raise ParameterError(f"hyperplane {text!r}: an empty column name after '@' (expected 'a,b,c@col1,col2')")
+            if len(set(columns)) != len(columns):
+                raise ParameterError(f"hyperplane {text!r}: a column is named twice after '@'")
         return cls(numbers[:-1], numbers[-1], columns)
 
     def resolve(self, structure) -> tuple[np.ndarray, float]:
