@@ -48,12 +48,23 @@ def _edit(path, fn, fix_checksum=True):
     (lambda d: d.update(schema="hwpts.reproduce/1"), False, "schema 'hwpts.reproduce/1' is not 'hwpts.pwarx/1'"),
     (lambda d: d["regions"][0]["theta"].__setitem__(0, 0.123), False, "checksum mismatch"),
     (lambda d: d.pop("partition"), False, "missing key 'partition'"),
-    (lambda d: d["regions"][1]["theta"].pop(), True, r"regions\[1\].theta has 6 numbers, expected 7"),
+    (lambda d: d["regions"][1]["theta"].pop(), True, r"regions\[1\].theta has 6 numbers, expected a list of 7"),
     (lambda d: d["partition"]["polyhedra"][0]["H"][0].append(1.0), True, r"polyhedra\[0\].H must be equal-length rows"),
     (lambda d: d["partition"]["polyhedra"][0].update(H=[[1.0] * 7, [1.0] * 7]), True, "must have 6 columns"),
     (lambda d: d["partition"]["polyhedra"].pop(), True, "2 polyhedra for 3 regions"),
     (lambda d: d["regions"][0].update(model="cubic"), True, "expected affine, constant or zero"),
     (lambda d: d["training"].update(output_range=[1.0, 0.0]), True, r"output_range must be \[low, high\]"),
+    # fields that contradict each other (found by a review, 2026-11-26: each was accepted)
+    (lambda d: d["structure"].update(constant=False), True, r"structure.constant is false but regions\[0\].theta ends"),
+    (lambda d: d["regions"][0].update(model="zero"), True, r"regions\[0\].model is 'zero' but its theta"),
+    (lambda d: d["regions"][0]["theta"].__setitem__(0, True), True, r"regions\[0\].theta must be .* got true/false"),
+    (lambda d: d["regions"][0]["theta"].__setitem__(0, 1e300), True, r"holds 1e\+300, beyond"),
+    (lambda d: d["regions"][0].update(theta=[d["regions"][0]["theta"]]), True, r"theta has shape \[1, 7\]"),
+    (lambda d: d["regions"][0].update(n_train_samples=-3), True, r"n_train_samples must be an int >= 0"),
+    (lambda d: d["regions"][0].update(n_train_samples=10 ** 30), True, r"n_train_samples must be an int >= 0"),
+    (lambda d: d["training"]["input_ranges"][0].reverse(), True, r"input_ranges must be \[low, high\] pairs"),
+    (lambda d: d["structure"].update(input_names=["u1", "u1"]), True, "structure.input_names names 'u1' twice"),
+    (lambda d: d["structure"].update(output_name="u1"), True, "structure.output_name 'u1' is also one of"),
 ])
 def test_bad_model_files(model_file, edit, fix, match):
     _edit(model_file, edit, fix)

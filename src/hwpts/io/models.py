@@ -191,13 +191,26 @@ def _require(doc, key, kind, where):
     return value
 
 
+MAX_MODEL_NUMBER = 1e100  # beyond it a parameter or boundary overflows in the first products
+
+
+def _has_bool(value) -> bool:
+    if isinstance(value, bool):
+        return True
+    return isinstance(value, list) and any(_has_bool(v) for v in value)
+
+
 def _numbers(value, shape_desc: str, where: str) -> np.ndarray:
+    if _has_bool(value):
+        raise DataError(f"{where} must be {shape_desc} of numbers, got true/false")
     try:
         arr = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise DataError(f"{where} must be {shape_desc} of numbers (got ragged or non-numeric values)") from None
     if not np.all(np.isfinite(arr)):
         raise DataError(f"{where} holds a non-finite number")
+    if arr.size and np.max(np.abs(arr)) > MAX_MODEL_NUMBER:
+        raise DataError(f"{where} holds {arr.flat[int(np.argmax(np.abs(arr)))]:.3g}, beyond +-{MAX_MODEL_NUMBER:.0e}")
     return arr
 
 
@@ -214,10 +227,15 @@ def _check_structure_types(st: dict) -> None:
         if not (_is_int(v) or (isinstance(v, list) and v and all(_is_int(x) for x in v))):
             raise DataError(f"structure.{key} must be an int or a list of ints, got {v!r}"[:200])
     names = st["input_names"]
-    if not (isinstance(names, list) and names and all(isinstance(x, str) for x in names)):
-        raise DataError(f"structure.input_names must be a list of strings, got {type(names).__name__}")
-    if not isinstance(st["output_name"], str):
-        raise DataError(f"structure.output_name must be a string, got {type(st['output_name']).__name__}")
+    if not (isinstance(names, list) and names and all(isinstance(x, str) and x for x in names)):
+        raise DataError(f"structure.input_names must be a list of non-empty strings, got {names!r}"[:200])
+    if not isinstance(st["output_name"], str) or not st["output_name"]:
+        raise DataError(f"structure.output_name must be a non-empty string, got {st['output_name']!r}"[:200])
+    twice = sorted({x for x in names if names.count(x) > 1})
+    if twice:
+        raise DataError(f"structure.input_names names {twice[0]!r} twice")
+    if st["output_name"] in names:
+        raise DataError(f"structure.output_name {st['output_name']!r} is also one of structure.input_names")
     if not isinstance(st["constant"], bool):
         raise DataError(f"structure.constant must be true or false, got {st['constant']!r}"[:200])
     powers = st.get("output_powers")
@@ -303,10 +321,22 @@ def model_from_dict(doc: dict):
     for i, reg in enumerate(regions):
         th = _numbers(_require(reg, "theta", list, f"regions[{i}]"), f"{nf + 1} numbers", f"regions[{i}].theta")
         if th.shape != (nf + 1,):
-            raise DataError(f"regions[{i}].theta has {th.size} numbers, expected {nf + 1} for {structure.describe_orders()}")
+            what = f"{th.size} numbers" if th.ndim == 1 else f"shape {list(th.shape)}"
+            raise DataError(f"regions[{i}].theta has {what}, expected a list of {nf + 1} numbers for "
+                            f"{structure.describe_orders()}")
         kind = _require(reg, "model", str, f"regions[{i}]")
         if kind not in ("affine", "constant", "zero"):
             raise DataError(f"regions[{i}].model is {kind!r}; expected affine, constant or zero")
+        # the fields must agree: a model that says one thing and computes another is refused
+        if kind == "zero" and np.any(th != 0):
+            raise DataError(f"regions[{i}].model is 'zero' but its theta is not all zeros")
+        if kind == "constant" and np.any(th[:-1] != 0):
+            raise DataError(f"regions[{i}].model is 'constant' but its theta has nonzero regressor coefficients")
+        if not structure.constant and th[-1] != 0:
+            raise DataError(f"structure.constant is false but regions[{i}].theta ends with the offset {th[-1]:.6g}")
+        count = reg.get("n_train_samples", 0)
+        if not _is_int(count) or not 0 <= count < 2 ** 53:
+            raise DataError(f"regions[{i}].n_train_samples must be an int >= 0, got {count!r}"[:200])
         theta.append(th)
         kinds.append(kind)
         covs.append(_covariance(reg, i, nf))
@@ -333,6 +363,8 @@ def model_from_dict(doc: dict):
     in_ranges = _numbers(_require(training, "input_ranges", list, "training"), "pairs", "training.input_ranges")
     if in_ranges.shape != (structure.n_inputs, 2):
         raise DataError(f"training.input_ranges must have {structure.n_inputs} [low, high] pairs")
+    if np.any(in_ranges[:, 0] > in_ranges[:, 1]):
+        raise DataError("training.input_ranges must be [low, high] pairs, got a low above its high")
     seg = doc.get("segmentation") or {}
     model = PWARX.from_parts(structure, partition, np.array(theta), kinds, out_range, in_ranges,
                              segmentation_info=seg if isinstance(seg, dict) else {})
