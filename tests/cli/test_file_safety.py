@@ -434,3 +434,20 @@ def test_a_summary_that_cannot_be_printed_leaves_no_model(tmp_path, monkeypatch,
     assert status == 2 and len(err) == 1 and "standard output: cannot write the summary" in err[0]
     assert not (tmp_path / "m.json").exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["d.csv"]
+
+
+def test_a_long_output_name_is_written_and_a_failed_write_leaves_no_folder(tmp_path, monkeypatch):
+    """A valid 240-character name was refused (the temporary name went over 255 bytes); the
+    folders a failed write created were left behind."""
+    from hwpts.io.atomic import write_text_atomic
+
+    long_name = tmp_path / ("a" * 240 + ".json")
+    write_text_atomic(long_name, "{}")
+    assert long_name.read_text() == "{}"
+
+    def fail():
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        write_text_atomic(tmp_path / "new" / "deeper" / "m.json", "{}", before_commit=fail)
+    assert not (tmp_path / "new").exists()

@@ -79,10 +79,28 @@ def process_alive(pid: int) -> bool:
     return True
 
 
+def _temporary_head(target: Path, end: str) -> str:
+    """The start of ``target``'s temporary names: its name (cut short so that the whole temporary
+    name stays within 255 bytes, a long but valid name was refused), then the process id."""
+    room = 255 - len(end.encode()) - 40  # ".", ".", the pid, mkstemp's 8 characters, a margin
+    name = target.name
+    while len(name.encode()) > room:
+        name = name[:-1]
+    return f".{name}."
+
+
+def _remove_created(folders) -> None:
+    """Remove the folders a failed or stopped write created (deepest first; a folder that holds
+    something else now stays)."""
+    for folder in reversed(folders):
+        with contextlib.suppress(OSError):
+            folder.rmdir()
+
+
 def _remove_stale_temporaries(target: Path, end: str) -> None:
     """Temporary files of ``target`` left by a run that was killed (SIGKILL, power loss): their
     name carries the writer's process id; those whose process is gone are removed."""
-    head = f".{target.name}."
+    head = _temporary_head(target, end)
     for stale in target.parent.glob(f"{glob_escape(head)}*{glob_escape(end)}"):
         pid_text = stale.name[len(head):].split(".", 1)[0]
         if pid_text.isdigit() and int(pid_text) != os.getpid() and not process_alive(int(pid_text)):
@@ -111,13 +129,19 @@ def atomic_path(path: str | os.PathLike, suffix: str | None = None):
     blocker = next((a for a in target.parents if a.exists() or a.is_symlink()), None)
     if blocker is not None and not blocker.is_dir():
         raise DataError(f"--out {str(target)!r}: expected a path in a folder, got {str(blocker)!r}, which is a file")
+    created = [a for a in reversed(target.parents) if not (a.exists() or a.is_symlink())]
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
         _remove_stale_temporaries(target, end)
-        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.{os.getpid()}.", suffix=end, dir=target.parent)
+        fd, tmp = tempfile.mkstemp(prefix=f"{_temporary_head(target, end)}{os.getpid()}.", suffix=end,
+                                   dir=target.parent)
         os.close(fd)
     except OSError as error:
+        _remove_created(created)
         raise DataError(f"--out {str(target)!r}: cannot write there ({error.strerror or error})") from None
+    except BaseException:
+        _remove_created(created)
+        raise
     try:
         yield Path(tmp)
         with point_of_no_return():
@@ -127,10 +151,12 @@ def atomic_path(path: str | os.PathLike, suffix: str | None = None):
     except OSError as error:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
+        _remove_created(created)
         raise DataError(f"--out {str(target)!r}: cannot write there ({error.strerror or error})") from None
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
+        _remove_created(created)
         raise
 
 
