@@ -30,7 +30,8 @@ class ArgumentParser(argparse.ArgumentParser):
 
     def error(self, message: str):  # noqa: D102 - argparse hook
         """Raise the parse error as a :class:`UsageError` (one line, exit 2) instead of printing usage."""
-        raise UsageError(f"{self.prog}: {message}")
+        command = self.prog.split(" ", 1)[1] if " " in self.prog else ""  # "hwpts identify" -> "identify"
+        raise UsageError(f"{command}: {message}" if command else message)
 
 
 def build_parser() -> ArgumentParser:
@@ -161,12 +162,18 @@ def _run(argv: Sequence[str] | None) -> int:
     return status
 
 
+def _one_line(text: str) -> str:
+    """``text`` on one line: a line break inside a value (an argument or file name holding one)
+    written as ``\\n``, so that an error stays the one line the contract promises."""
+    return text.replace("\r", "\\r").replace("\n", "\\n")
+
+
 def _report(error: BaseException) -> int:
     """One line on stderr for a known failure; anything else is re-raised (a bug: keep its traceback)."""
     try:
         raise error
     except HwptsError as error:
-        print(f"hwpts: error: {error}", file=sys.stderr)
+        print(f"hwpts: error: {_one_line(str(error))}", file=sys.stderr)
         return EXIT_USAGE
     except OSError as error:
         if isinstance(error, BrokenPipeError):

@@ -147,6 +147,7 @@ CASES = [
     (["identify", f"{W}/data.csv", *FIT, "--na", "2", "--nb", "2", "--hyperplane", "1,0,0", "--regions", "5",
       "--out", f"{W}/m.json"], "--regions 5: 1 --hyperplane make 2 regions"),
     (["validate", f"{W}/model.json", f"{W}/bigtime.csv", "--resample"], "--resample: the record spans"),
+    (["validate", f"{W}/model.json", f"{W}/data.csv", "extra\nline"], "unrecognized arguments: extra\\nline"),
     # --- the parser
     ([], "COMMAND"),
     (["fly"], "invalid choice: 'fly'"),
