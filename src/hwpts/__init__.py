@@ -11,7 +11,34 @@ Layers:
 - :mod:`hwpts.commands` and :mod:`hwpts.cli` - the ``hwpts`` command line.
 """
 
-from hwpts.errors import (
+import os as _os
+
+
+def _numba_cache_dir() -> None:
+    """Give numba a cache folder where it would find none (it raises at the first compiled
+    function then): a read-only install with no writable home. The package's own ``__pycache__``
+    or the user's cache folder is used when either is writable; else a private temporary folder
+    of this process (mode 0700: a shared, predictable one would let another user plant code)."""
+    if _os.environ.get("NUMBA_CACHE_DIR") or _os.access(_os.path.dirname(__file__), _os.W_OK):
+        return
+    base = _os.environ.get("XDG_CACHE_HOME") or _os.path.join(_os.path.expanduser("~"), ".cache")
+    try:
+        _os.makedirs(base, exist_ok=True)
+        if _os.access(base, _os.W_OK):
+            return
+    except OSError:
+        pass
+    import tempfile
+
+    try:
+        _os.environ["NUMBA_CACHE_DIR"] = tempfile.mkdtemp(prefix="hwpts-numba-")
+    except OSError:  # no writable temporary folder either: numba will say so
+        pass
+
+
+_numba_cache_dir()
+
+from hwpts.errors import (  # noqa: E402 - after the cache folder, before numba is imported
     DataError,
     HwptsError,
     IdentificationError,

@@ -403,9 +403,30 @@ def test_a_read_only_install_still_runs(tmp_path):
         assert run.returncode == 0 and run.stderr == "", run.stderr
         assert json.loads(run.stdout)["motor_a_speed_rpm"] > 1000
         assert not list((site / "hwpts").rglob("__pycache__"))
+        # ... and with a home that cannot be made (no cache folder for numba at all), identify
+        # compiles its kernels too (it raised "cannot cache function '_alternate_kernel'")
+        data = tmp_path / "d.csv"
+        rng = np.random.default_rng(0)
+        u = rng.uniform(-1, 1, 400)
+        y = np.zeros(400)
+        for k in range(1, 400):
+            y[k] = 0.5 * y[k - 1] + u[k - 1] if y[k - 1] >= 0 else -0.4 * y[k - 1] + 2 * u[k - 1]
+        data.write_text("u,y\n" + "".join(f"{a},{b}\n" for a, b in zip(u, y)))
+        os.chmod(tmp_path, 0o777)
+        locked = tmp_path / "locked"  # a home inside a folder nobody may write: it cannot be made
+        locked.mkdir(mode=0o555)
+        env["HOME"] = str(locked / "home")
+        env.pop("XDG_CACHE_HOME", None)
+        run = subprocess.run([*prefix, sys.executable, "-m", "hwpts", "identify", str(data), "--input", "u",
+                              "--output", "y", "--na", "1", "--nb", "1", "--segmentation", "alternating",
+                              "--regions", "2", "--out", str(tmp_path / "m.json")],
+                             capture_output=True, text=True, env=env, cwd=tmp_path, timeout=300)
+        assert run.returncode == 0 and "Traceback" not in run.stderr, run.stderr[-500:]
     finally:
         for path in [site, *site.rglob("*")]:
             os.chmod(path, 0o755 if path.is_dir() else 0o644)
+        if (tmp_path / "locked").exists():
+            os.chmod(tmp_path / "locked", 0o755)
 
 
 def test_a_summary_that_cannot_be_printed_leaves_no_model(tmp_path, monkeypatch, capsys):
