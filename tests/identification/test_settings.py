@@ -157,3 +157,16 @@ def test_one_partition_column_name_is_one_column_and_an_empty_simulation_is_refu
     np.testing.assert_array_equal(one.theta_, listed.theta_)
     with pytest.raises(DataError, match="at least one sample"):
         one.simulate(u[:0], y[:0])
+
+
+def test_a_prediction_needs_only_its_initial_conditions_and_a_static_map_no_output():
+    """Prediction applied the fit's length rule (7 samples for 2/2/1 where 3 predict one); a
+    static map refused to predict without the output it does not use."""
+    u, y = two_modes()
+    model = PWARX(2, 2, 1, segmentation="threshold", random_state=0).fit(u, y)
+    np.testing.assert_allclose(model.predict(u[:3], y[:3]), model.predict(u[:6], y[:6])[:3])
+    with pytest.raises(DataError, match="more than the 2 initial samples, got 2"):
+        model.predict(u[:2], y[:2])
+    static = PWARX(0, 1, 0, segmentation="threshold", random_state=0).fit(u, np.abs(u[:, 0]) + 0.5 * u[:, 0])
+    np.testing.assert_allclose(static.predict(u[:4]), np.abs(u[:4, 0]) + 0.5 * u[:4, 0], atol=0.05)
+    assert static.predict_regions(u[:4]).shape == (4,)

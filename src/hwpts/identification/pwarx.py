@@ -424,6 +424,19 @@ class PWARX(BaseEstimator):
             raise DataError(f"expected {self.n_features_in_} input columns, got {u.shape[1]}")
         return u, yy
 
+    def _prediction_inputs(self, X, y):
+        """Inputs and outputs for a prediction: the measured output only where the regressor has
+        lags (a static map predicts from its inputs), and at least one sample beyond the initial
+        conditions (not as many as a fit needs)."""
+        check_is_fitted(self, "theta_")
+        m = self.structure_.max_lag
+        u, yy = self._check_inputs(X, y, need_y=m > 0)
+        if yy is None:
+            yy = np.zeros(u.shape[0])
+        if u.shape[0] <= m:
+            raise DataError(f"a prediction needs more than the {m} initial samples, got {u.shape[0]}")
+        return u, yy
+
     def predict(self, X, y=None, horizon: int = 1) -> np.ndarray:
         """``horizon``-step-ahead prediction from measured past outputs (eq. 5).
 
@@ -433,8 +446,7 @@ class PWARX(BaseEstimator):
         ``n - max_lag`` or more is the free run :meth:`simulate`. Returns an array of length n;
         its first ``max_lag`` entries are the measured outputs (``nan`` where a run diverged).
         """
-        u, yy = self._check_inputs(X, y)
-        self.structure_.check_length(yy.shape[0])
+        u, yy = self._prediction_inputs(X, y)
         if isinstance(horizon, bool) or not isinstance(horizon, (int, np.integer)) or horizon < 1:
             raise ParameterError(f"horizon must be an int >= 1 (samples), got {horizon!r}")
         if horizon == 1:
@@ -446,8 +458,7 @@ class PWARX(BaseEstimator):
 
     def predict_regions(self, X, y=None) -> np.ndarray:
         """Region (0-based) of each sample's measured regressor (eq. 8); ``-1`` for the first max_lag."""
-        u, yy = self._check_inputs(X, y)
-        self.structure_.check_length(yy.shape[0])
+        u, yy = self._prediction_inputs(X, y)
         _, regions = one_step_pwarx(self.structure_, self.partition_, self.theta_, u, yy)
         return regions
 

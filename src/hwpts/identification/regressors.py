@@ -249,8 +249,11 @@ class RegressorStructure:
             f"{list(self.input_names)}"
         )
 
-    def build(self, inputs: np.ndarray, output: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Regressor matrix X (rows x_k', eq. 7) and targets y(k), for k = max_lag .. n-1."""
+    def build(self, inputs: np.ndarray, output: np.ndarray, fit: bool = True) -> tuple[np.ndarray, np.ndarray]:
+        """Regressor matrix X (rows x_k', eq. 7) and targets y(k), for k = max_lag .. n-1.
+
+        ``fit``: the record must hold enough rows to fit the parameters (:meth:`check_length`);
+        ``False`` (a prediction): one row beyond the initial conditions is enough."""
         u = np.asarray(inputs, dtype=float)
         if u.ndim == 1:
             u = u[:, None]
@@ -260,7 +263,10 @@ class RegressorStructure:
         if y.ndim != 1 or y.shape[0] != u.shape[0]:
             raise DataError(f"output must have shape ({u.shape[0]},); got {y.shape}")
         n = y.shape[0]
-        self.check_length(n)
+        if fit:
+            self.check_length(n)
+        elif n <= self.max_lag:
+            raise DataError(f"a prediction needs more than the {self.max_lag} initial samples, got {n}")
         m = self.max_lag
         rows = n - m
         X = np.empty((rows, self.n_features))

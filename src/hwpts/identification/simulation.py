@@ -189,7 +189,7 @@ def simulate_pwarx(structure, partition, theta, inputs, initial_output, center=0
 
 def one_step_pwarx(structure, partition, theta, inputs, output) -> tuple[np.ndarray, np.ndarray]:
     """One-step-ahead prediction from measured outputs: (yhat, regions), first max_lag measured/-1."""
-    X, _ = structure.build(inputs, output)
+    X, _ = structure.build(inputs, output, fit=False)
     regions = partition.predict(X)
     th = np.asarray(theta)[regions]
     pred = np.einsum("ij,ij->i", X, th[:, :-1]) + th[:, -1]
@@ -222,7 +222,7 @@ def k_step_pwarx(structure, partition, theta, inputs, output, horizon: int,
     if horizon >= n - m:  # every start falls at the initial conditions: the free run
         sim = simulate_pwarx(structure, partition, theta, inputs, y, center, bound)
         return sim.output, sim.regions
-    X, _ = structure.build(inputs, y)
+    X, _ = structure.build(inputs, y, fit=False)
     na = structure.na
     th = np.asarray(theta, dtype=float)
     t = np.arange(m, n)
