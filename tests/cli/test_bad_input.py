@@ -148,6 +148,8 @@ CASES = [
       "--out", f"{W}/m.json"], "--regions 5: 1 --hyperplane make 2 regions"),
     (["validate", f"{W}/model.json", f"{W}/bigtime.csv", "--resample"], "--resample: the record spans"),
     (["validate", f"{W}/model.json", f"{W}/data.csv", "extra\nline"], "unrecognized arguments: extra\\nline"),
+    (["identify", f"{W}/data.csv", "--input", "u1", "--output", "", "--na", "1", "--nb", "1", "--out", f"{W}/m.json"],
+     "--output: expected a column name, got an empty one"),
     # --- the parser
     ([], "COMMAND"),
     (["fly"], "invalid choice: 'fly'"),

@@ -504,3 +504,23 @@ def test_identify_output_powers_name_a_partition_column_and_count_in_the_region_
     assert main([*base, "--regions", "50", "--output-powers", "2,3", "--out", str(tmp_path / "m50.json")]) == 2
     err = capsys.readouterr().err
     assert "--regions 50: expected at most 44 for 800 samples" in err and "6 parameters a region" in err
+
+
+def test_data_without_a_time_column_is_taken_at_the_models_rate(tmp_path, capsys):
+    """predict wrote the sample numbers as time_s (0, 1, 2 ... 'seconds') for a model sampled at
+    10 ms; the samples of a file without time are taken at the model's rate."""
+    import csv
+
+    rng = np.random.default_rng(0)
+    u = rng.uniform(-1, 1, 300)
+    y = np.zeros(300)
+    for k in range(1, 300):
+        y[k] = 0.6 * y[k - 1] + u[k - 1]
+    (tmp_path / "timed.csv").write_text("time_s,u,y\n" + "".join(f"{k * 0.01},{u[k]},{y[k]}\n" for k in range(300)))
+    (tmp_path / "plain.csv").write_text("u,y\n" + "".join(f"{u[k]},{y[k]}\n" for k in range(300)))
+    assert main(["identify", str(tmp_path / "timed.csv"), "--input", "u", "--output", "y", "--na", "1", "--nb", "1",
+                 "--segmentation", "average", "--out", str(tmp_path / "m.json")]) == 0
+    assert main(["predict", str(tmp_path / "m.json"), str(tmp_path / "plain.csv"), "--out", str(tmp_path / "p.csv")]) == 0
+    with open(tmp_path / "p.csv") as f:
+        t = np.array([float(r["time_s"]) for r in csv.DictReader(f)])
+    np.testing.assert_allclose(t, np.arange(300) * 0.01, atol=1e-12)

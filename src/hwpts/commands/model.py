@@ -80,6 +80,9 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
     from hwpts.dataset import IODataset
     from hwpts.io.datasets import numeric_share, read_table
 
+    for flag, names in (("--input", input_names), ("--output", [output_name])):
+        if any(not str(name).strip() for name in names):
+            raise ParameterError(f"{flag}: expected a column name, got an empty one")
     signals = [*input_names, output_name]
     if time_name == NO_TIME:
         candidates = []
@@ -168,6 +171,13 @@ def _check_sample_time(model, data, dt, path, resample: bool):
     if model_dt is None or dt is None:
         if resample:
             raise ParameterError("--resample needs a time column in DATA and a model that knows its sample time")
+        if model_dt is not None:
+            # no time column: the samples are taken at the model's rate (their time in seconds, not
+            # the sample numbers labelled as seconds in the written time_s column and the plots)
+            from hwpts.dataset import IODataset
+
+            return IODataset(data.time * model_dt, data.inputs, data.output, data.input_names, data.output_name,
+                             extra=data.extra)
         return data
     if abs(dt - model_dt) <= SAMPLE_TIME_TOLERANCE * model_dt:
         return data
