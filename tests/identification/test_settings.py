@@ -170,3 +170,14 @@ def test_a_prediction_needs_only_its_initial_conditions_and_a_static_map_no_outp
     static = PWARX(0, 1, 0, segmentation="threshold", random_state=0).fit(u, np.abs(u[:, 0]) + 0.5 * u[:, 0])
     np.testing.assert_allclose(static.predict(u[:4]), np.abs(u[:4, 0]) + 0.5 * u[:4, 0], atol=0.05)
     assert static.predict_regions(u[:4]).shape == (4,)
+
+
+def test_a_constant_held_out_block_is_named_and_a_tiny_output_is_not_called_constant():
+    rng = np.random.default_rng(0)
+    u = rng.uniform(-1, 1, 300)[:, None]
+    y = np.zeros(300)
+    y[150] = 1.0
+    with pytest.raises(DataError, match="the output is constant over held-out block 1 of 5"):
+        PWARXSearch(PWARX(1, 1, 1, random_state=0)).fit(u, y)
+    with pytest.raises(DataError, match="varies by 2e-200 only"):
+        fit_percent([1e-200, 3e-200, 2e-200], [0.0, 0.0, 0.0])

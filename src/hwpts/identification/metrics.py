@@ -43,6 +43,9 @@ def fit_percent(y, yhat) -> float:
         return float("nan")
     den = np.linalg.norm(y - y.mean())
     if den == 0:
+        if np.ptp(y) > 0:  # it varies, by less than the squares can hold (1e-200)
+            raise DataError(f"fit % is undefined: the measured output varies by {np.ptp(y):.3g} only, below what "
+                            f"its squares can hold; rescale it")
         raise DataError("fit % is undefined for a constant measured output")
     return float(100.0 * (1.0 - np.linalg.norm(y - yhat) / den))
 

@@ -82,7 +82,7 @@ import warnings
 import numpy as np
 from sklearn.base import BaseEstimator, clone
 
-from hwpts.errors import HwptsError, IdentificationError, ParameterError
+from hwpts.errors import DataError, HwptsError, IdentificationError, ParameterError
 from hwpts.identification.metrics import fit_percent
 from hwpts.identification.selection.splitters import BlockedSplit, breaks_of
 from hwpts.identification.threads import single_threaded
@@ -568,6 +568,11 @@ class PWARXSearch(BaseEstimator):
         order_grid = self._order_grid(base, u, yy)
         max_lag = max(self._max_lag(base, o) for o in order_grid)
         splits = self._splits(n, max_lag)
+        for number, (_, test) in enumerate(splits, start=1):
+            if test.size > max_lag and np.ptp(yy[test[max_lag:]]) == 0:
+                raise DataError(f"PWARXSearch: the output is constant over held-out block {number} of {len(splits)} "
+                                f"(samples {test[0]}-{test[-1]}): no fit % can score a model there; give the model "
+                                f"settings (orders, segmentation, regions) or data whose output moves throughout")
         self.n_splits_ = len(splits)
         bar = None
         if self.progress:
