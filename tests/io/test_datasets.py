@@ -121,3 +121,10 @@ def test_parquet_time_stamps_are_seconds_and_big_integers_are_read(tmp_path):
     pq.write_table(pa.table({"a": np.ones(3), "b": np.ones(3)}).rename_columns(["u", "u"]), tmp_path / "dup.parquet")
     with pytest.raises(DataError, match=r"duplicate column name\(s\) \['u'\]"):
         read_table(tmp_path / "dup.parquet")
+
+
+def test_a_mat_matrix_column_and_a_variable_of_its_name_are_refused(tmp_path):
+    """Column 1 of matrix u became u_1 and a variable u_1 silently replaced it (or the reverse)."""
+    savemat(tmp_path / "clash.mat", {"u": np.ones((10, 2)), "u_1": -np.ones(10), "y": np.arange(10.0)})
+    with pytest.raises(DataError, match="column 1 of matrix 'u' and the variable 'u_1'"):
+        read_table(tmp_path / "clash.mat")

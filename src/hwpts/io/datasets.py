@@ -375,7 +375,11 @@ def _read_mat(p: Path) -> dict[str, np.ndarray]:
             if arr.shape[0] < arr.shape[1]:
                 arr = arr.T
             for j in range(arr.shape[1]):
-                out[f"{name}_{j + 1}"] = arr[:, j]
+                column = f"{name}_{j + 1}"
+                if column in raw or column in out:  # a variable of that name: neither may shadow the other
+                    raise DataError(f"{str(p)!r}: column {j + 1} of matrix {name!r} and the variable {column!r} "
+                                    f"would both be the column {column!r}; rename one of them")
+                out[column] = arr[:, j]
     if not out:
         raise DataError(f"{str(p)!r}: no numeric vector variables in the .mat file")
     return out
