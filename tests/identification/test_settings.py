@@ -181,3 +181,12 @@ def test_a_constant_held_out_block_is_named_and_a_tiny_output_is_not_called_cons
         PWARXSearch(PWARX(1, 1, 1, random_state=0)).fit(u, y)
     with pytest.raises(DataError, match="varies by 2e-200 only"):
         fit_percent([1e-200, 3e-200, 2e-200], [0.0, 0.0, 0.0])
+
+
+def test_the_search_delegates_what_its_model_does():
+    u, y = two_modes()
+    search = PWARXSearch(PWARX(1, 1, 1, random_state=0), methods="threshold", output_powers=None).fit(u, y)
+    model = search.best_estimator_
+    np.testing.assert_array_equal(search.predict(u, y, horizon=3), model.predict(u, y, horizon=3))
+    np.testing.assert_array_equal(search.predict_regions(u, y), model.predict_regions(u, y))
+    assert search.n_features_in_ == 1

@@ -1067,9 +1067,18 @@ class PWARXSearch(BaseEstimator):
         check_is_fitted(self, "best_estimator_")
         return self.best_estimator_
 
-    def predict(self, X, y=None):
-        """One-step-ahead prediction of the chosen model."""
-        return self._check().predict(X, y)
+    def predict(self, X, y=None, horizon: int = 1):
+        """``horizon``-step-ahead prediction of the chosen model (:meth:`PWARX.predict`)."""
+        return self._check().predict(X, y, horizon)
+
+    def predict_regions(self, X, y=None):
+        """Region of each sample under the chosen model (:meth:`PWARX.predict_regions`)."""
+        return self._check().predict_regions(X, y)
+
+    @property
+    def n_features_in_(self) -> int:
+        """Input columns of the chosen model (scikit-learn's attribute)."""
+        return self._check().n_features_in_
 
     def simulate(self, X, y=None, initial_output=None):
         """Free run of the chosen model."""
