@@ -190,3 +190,17 @@ def test_the_search_delegates_what_its_model_does():
     np.testing.assert_array_equal(search.predict(u, y, horizon=3), model.predict(u, y, horizon=3))
     np.testing.assert_array_equal(search.predict_regions(u, y), model.predict_regions(u, y))
     assert search.n_features_in_ == 1
+
+
+def test_frames_a_named_series_and_a_model_fitted_on_arrays():
+    pd = pytest.importorskip("pandas")
+    u, y = two_modes()
+    model = PWARX(1, 1, 1, segmentation="threshold", random_state=0).fit(pd.Series(u[:, 0], name="valve"), y)
+    assert model.input_names_ == ("valve",)
+    named = PWARX(1, 1, 1, segmentation="threshold", random_state=0).fit(pd.Series(u[:, 0], name="v"), y,
+                                                                          input_names=["valve"])
+    assert named.input_names_ == ("valve",)
+    plain = PWARX(1, 1, 1, segmentation="threshold", random_state=0).fit(u, y)
+    with pytest.warns(UserWarning, match="fitted without names"):
+        got = plain.predict(pd.DataFrame({"valve": u[:, 0]}), y)
+    np.testing.assert_array_equal(got, plain.predict(u, y))

@@ -195,6 +195,8 @@ class PWARX(BaseEstimator):
         if y is None:
             raise ParameterError("fit needs the measured output y (or an IODataset)")
         frame_names = _column_names(X)
+        if frame_names is not None and getattr(X, "columns", None) is None and names is not None:
+            frame_names = None  # a named Series: the names given win over its name
         if frame_names is not None:
             if names is not None and tuple(names) != frame_names:
                 raise ParameterError(f"input_names {list(names)} differ from the DataFrame's columns "
@@ -619,8 +621,13 @@ def _check_breaks(breaks, n):
 
 def _column_names(X) -> tuple[str, ...] | None:
     """The column names of a DataFrame-like ``X`` (pandas, polars: a ``columns`` attribute), else None."""
+    if isinstance(X, np.ndarray):
+        return None
     columns = getattr(X, "columns", None)
-    if columns is None or isinstance(X, np.ndarray):
+    if columns is None:
+        name = getattr(X, "name", None)  # a named Series: one input of that name
+        if isinstance(name, str) and name and getattr(X, "ndim", None) == 1:
+            return (name,)
         return None
     return tuple(str(c) for c in columns)
 
@@ -646,6 +653,13 @@ def _select_columns(u, names, wanted) -> np.ndarray:
     """The columns of ``u`` (named ``names``) in the order ``wanted``: data are matched by name."""
     names = tuple(names)
     if names == tuple(wanted):
+        return u
+    unnamed = tuple(f"u{j + 1}" for j in range(len(wanted)))
+    if tuple(wanted) == unnamed and len(names) == len(wanted) and not set(names) & set(unnamed):
+        # a model fitted on arrays (its inputs unnamed) given a DataFrame: its columns in order,
+        # as scikit-learn takes them, with a warning
+        warnings.warn(f"the model's inputs were fitted without names; the data's columns {list(names)} are "
+                      f"taken in that order", UserWarning, stacklevel=4)
         return u
     missing = [w for w in wanted if w not in names]
     if missing:
