@@ -212,3 +212,16 @@ def test_two_inputs_with_their_own_dead_times_through_the_search():
     search = PWARXSearch(PWARX(random_state=0), orders=grid, max_regions=2, try_polish=False).fit(u, y)
     assert search.input_delays_ == (0, 6)
     assert search.best_estimator_.structure_.nk in ((0, 6), (0, 5))
+
+
+@pytest.mark.parametrize("d", [1, 2, 3, 5])
+def test_a_pure_dead_time_is_not_read_one_sample_short(d):
+    """y(k) = 0.7 y(k-1) + u(k-d): the windows of two lags at d-1 and d both hold u(k-d), and the
+    argmin between their equal losses read d = 2 as 1 on 10 seeds of 10 (d = 5 as 4 on 4)."""
+    for seed in range(10):
+        rng = np.random.default_rng(seed)
+        u = rng.uniform(-1, 1, 2000)
+        y = np.zeros(2000)
+        for k in range(d + 1, 2000):
+            y[k] = 0.7 * y[k - 1] + u[k - d] + 0.01 * rng.standard_normal()
+        assert estimate_delays(u, y) == (d,), seed

@@ -164,7 +164,17 @@ def estimate_delays(u, y, *, max_delay: int = MAX_DELAY, na: int = 2, nb: int = 
         # than the best of the other windows would cut by chance (where the input barely moves
         # the output the losses are flat, and their argmin is noise)
         margin = max(tolerance, DELAY_CHANCE / t.size)
-        delays.append(best if best >= 2 and losses[best] < (1.0 - margin) * losses[near] else near)
+        delay = best if best >= 2 and losses[best] < (1.0 - margin) * losses[near] else near
+        # the window of nb lags at ``delay`` and the one a sample later both hold u(k - d) when
+        # the response starts at d = delay + 1: equal losses, so the argmin is a coin flip between
+        # d - 1 and d (a pure delay of 2 read as 1 on 10 seeds of 10). The later window costing no
+        # more than chance, and the one after it clearly more (the response's first lag has left
+        # it; on a flat loss curve, where the input barely moves the output, nothing is shifted),
+        # says the earlier window's first lag is not needed: the delay is one sample later.
+        if delay + 2 <= top and losses[delay + 1] <= (1.0 + DELAY_CHANCE / t.size) * losses[delay] \
+                and losses[delay + 2] > (1.0 + margin) * losses[delay + 1]:
+            delay += 1
+        delays.append(delay)
     return tuple(delays)
 
 
