@@ -22,18 +22,21 @@ def _numba_cache_dir() -> None:
     if _os.environ.get("NUMBA_CACHE_DIR") or _os.access(_os.path.dirname(__file__), _os.W_OK):
         return
     base = _os.environ.get("XDG_CACHE_HOME") or _os.path.join(_os.path.expanduser("~"), ".cache")
-    try:
-        _os.makedirs(base, exist_ok=True)
-        if _os.access(base, _os.W_OK):
-            return
-    except OSError:
-        pass
+    while base and not _os.path.exists(base):  # numba makes the folder if its first existing parent is writable
+        parent = _os.path.dirname(base)
+        base = "" if parent == base else parent
+    if base and _os.access(base, _os.W_OK):
+        return
+    import atexit
+    import shutil
     import tempfile
 
     try:
-        _os.environ["NUMBA_CACHE_DIR"] = tempfile.mkdtemp(prefix="hwpts-numba-")
+        folder = tempfile.mkdtemp(prefix="hwpts-numba-")
     except OSError:  # no writable temporary folder either: numba will say so
-        pass
+        return
+    _os.environ["NUMBA_CACHE_DIR"] = folder
+    atexit.register(shutil.rmtree, folder, True)  # the process's own cache: gone with it
 
 
 _numba_cache_dir()

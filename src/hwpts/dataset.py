@@ -99,7 +99,8 @@ class IODataset:
             return float("nan")
         return float(np.median(np.diff(self.time)))
 
-    def uniform_sample_time(self, what: str = "the time column") -> float | None:
+    def uniform_sample_time(self, what: str = "the time column",
+                            remedy: str = "resample the data, or split the record at the gap") -> float | None:
         """The sample period [s] when the time axis is uniform (every step within 1 % of the
         median; ``None`` for fewer than two samples), else a :class:`DataError` naming the first
         row where it is not: lagged regressors across a gap or a jitter mean other delays."""
@@ -111,8 +112,7 @@ class IODataset:
         if worst > 0.01 * dt:
             row = int(np.argmax(np.abs(steps - dt))) + 1
             raise DataError(f"{what} is not uniformly sampled (step {dt:.6g} s, but {steps[row - 1]:.6g} s at row "
-                            f"{row}); PWARX models need a constant sample time: resample, or fit the stretches "
-                            f"as one record with breaks at the gaps")
+                            f"{row}); PWARX models need a constant sample time: {remedy}")
         return dt
 
     def input(self, name: str) -> np.ndarray:

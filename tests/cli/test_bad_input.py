@@ -92,6 +92,8 @@ def workspace(tmp_path_factory):
         "typotime.csv": "time_s,u1,u2,y\n" + "".join(f"{'15.0.1' if i == 5 else i * 0.1},{i % 4},{i % 3},{i}\n"
                                                       for i in range(40)),
         "underscore.csv": "u1,u2,y\n" + "".join(f"{'1_000' if i == 5 else i % 4},{i % 3},{i}\n" for i in range(40)),
+        "twotime.csv": "time,t_s,u1,u2,y\n" + "".join(f"12:00:{i:02d},{i * 0.1},{i % 4},{i % 3},{i % 5}\n"
+                                                      for i in range(40)),
         "bigtime.csv": "time_s,u1,u2,y\n" + "".join(f"{i * 1e6},{i % 4},{i % 3},{i % 5}\n" for i in range(40)),
     }
     for name, text in files.items():
@@ -136,8 +138,11 @@ CASES = [
     # resampled record too long for memory
     (["validate", f"{W}/model.json", f"{W}/typotime.csv"], "line 7, column 'time_s': expected a number, got '15.0.1'"),
     (["identify", f"{W}/underscore.csv", *FIXED, "--out", f"{W}/m.json"], "got '1_000'"),
-    (["identify", f"{W}/data.csv", *FIXED, "--rows", "0:100000", "--out", f"{W}/m.json"], "--rows 0:100000: 100000 is beyond"),
-    (["identify", f"{W}/data.csv", *FIXED, "--rows=-1000:", "--out", f"{W}/m.json"], "--rows -1000:"),
+    (["identify", f"{W}/data.csv", *FIXED, "--rows", "1_0:50", "--out", f"{W}/m.json"], "--rows expects START:STOP"),
+    # a text column named "time" beside a numeric t_s: the t_s axis is read, at another rate than the model's
+    (["validate", f"{W}/model.json", f"{W}/twotime.csv"], "sample time 0.1 s"),
+    (["identify", f"{W}/data.csv", *FIXED, "--rows", "0:100000", "--out", f"{W}/m.json"], "--rows '0:100000': 100000 is beyond"),
+    (["identify", f"{W}/data.csv", *FIXED, "--rows=-1000:", "--out", f"{W}/m.json"], "--rows '-1000:'"),
     (["identify", f"{W}/data.csv", *FIT, "--na", "2", "--nb", "2", "--hyperplane", "1,,0.2", "--out", f"{W}/m.json"],
      "hyperplane '1,,0.2': expected numbers"),
     (["identify", f"{W}/data.csv", *FIT, "--na", "2", "--nb", "2", "--hyperplane", "1,0,0@", "--out", f"{W}/m.json"],

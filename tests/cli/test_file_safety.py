@@ -472,3 +472,20 @@ def test_a_long_output_name_is_written_and_a_failed_write_leaves_no_folder(tmp_p
     with pytest.raises(KeyboardInterrupt):
         write_text_atomic(tmp_path / "new" / "deeper" / "m.json", "{}", before_commit=fail)
     assert not (tmp_path / "new").exists()
+
+
+def test_a_closed_stdout_still_writes_the_model_and_a_long_suffix_is_an_error(tmp_path, monkeypatch):
+    from hwpts.errors import DataError
+    from hwpts.io.atomic import write_text_atomic
+
+    d = make_system(5, rng=0, n=300)
+    write_csv(tmp_path / "d.csv", {"u1": d.inputs[:, 0], "u2": d.inputs[:, 1], "y": d.output})
+    monkeypatch.setattr("sys.stdout", None)  # started with >&-
+    status = main(["identify", str(tmp_path / "d.csv"), "--input", "u1", "--input", "u2", "--output", "y",
+                   "--na", "2", "--nb", "2", "--segmentation", "average", "--out", str(tmp_path / "m.json")])
+    monkeypatch.undo()
+    assert status == 0 and (tmp_path / "m.json").exists()
+    write_text_atomic(tmp_path / ("x." + "b" * 215), "{}")  # it looped for ever cutting the name
+    assert (tmp_path / ("x." + "b" * 215)).read_text() == "{}"
+    with pytest.raises(DataError, match="cannot write there"):
+        write_text_atomic(tmp_path / ("x." + "b" * 300), "{}")  # too long for the file system

@@ -29,7 +29,7 @@ def two_modes(n=600, seed=0):
     (dict(classifier_C=float("nan")), "classifier_C must be a number > 0"),
     (dict(refinement_rounds=1.5), "refinement_rounds must be an int >= 0, got 1.5"),
     (dict(refinement_rounds=-1), "refinement_rounds must be an int >= 0"),
-    (dict(random_state="a"), "random_state must be None or an int >= 0, got 'a'"),
+    (dict(random_state="a"), "random_state must be None, an int >= 0 or a numpy Generator or SeedSequence, got 'a'"),
 ])
 def test_estimator_settings_are_checked(setting, match):
     u, y = two_modes()
@@ -46,7 +46,7 @@ def test_input_names_must_name_each_input_once(names, match):
     u, y = two_modes()
     u2 = np.column_stack([u[:, 0], u[::-1, 0]])
     with pytest.raises(ParameterError, match=match):
-        PWARX(1, 1, 1).fit(u if names == ["y"] else u2, y, input_names=names)
+        PWARX(1, 1, 1).fit(u if names == ["y"] else u2, y, input_names=names, output_name="y")
 
 
 @pytest.mark.parametrize("breaks", ["300", [0], [600], [5000], [2.5]])
@@ -204,3 +204,17 @@ def test_frames_a_named_series_and_a_model_fitted_on_arrays():
     with pytest.warns(UserWarning, match="fitted without names"):
         got = plain.predict(pd.DataFrame({"valve": u[:, 0]}), y)
     np.testing.assert_array_equal(got, plain.predict(u, y))
+
+
+def test_seeds_numpy_takes_and_an_input_named_y():
+    """RandomState and SeedSequence seeds are accepted as numpy's default_rng takes them; an input
+    named "y" beside an unnamed output leaves the output "y_out" (it was refused as the output's name)."""
+    u, y = two_modes()
+    for seed in (np.random.RandomState(0), np.random.SeedSequence(0), np.int64(3)):
+        PWARX(1, 1, 1, segmentation="threshold", random_state=seed).fit(u, y)
+    with pytest.raises(ParameterError, match="random_state must be None, an int >= 0 or a numpy Generator"):
+        PWARX(1, 1, 1, random_state=-1).fit(u, y)
+    model = PWARX(1, 1, 1, segmentation="threshold", random_state=0).fit(u, y, input_names=["y"])
+    assert model.output_name_ == "y_out" and model.structure_.feature_names == ["y_out(k-1)", "y(k-1)"]
+    with pytest.raises(ParameterError, match="input name 'y' is the output's name"):
+        PWARX(1, 1, 1).fit(u, y, input_names=["y"], output_name="y")

@@ -42,6 +42,8 @@ def _rows(text: str | None):
     try:
         if len(parts) != 2:
             raise ValueError
+        if "_" in str(text):  # int() reads "1_0" as 10
+            raise ValueError
         start = int(parts[0]) if parts[0].strip() else None
         stop = int(parts[1]) if parts[1].strip() else None
     except ValueError:
@@ -95,11 +97,17 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
     except DataError:
         if time_name is not None or not candidates:
             raise
-        columns = read_table(path, signals)  # a conventionally named column that holds text is no time axis
-        for name in candidates:  # ... but one of numbers with a mistyped cell is a broken time axis
-            if numeric_share(path, name) >= 0.9:
-                read_table(path, [*signals, name])  # raises the cell's line and text
-                raise
+        columns = read_table(path, signals)
+        readable = []
+        for name in candidates:  # a conventionally named column that holds text is no time axis ...
+            try:
+                read_table(path, [*signals, name])
+                readable.append(name)
+            except DataError:
+                if numeric_share(path, name) >= 0.9:  # ... but one of numbers with a mistyped cell is broken
+                    raise
+        if readable:
+            columns = read_table(path, [*signals, *readable])
     if time_name not in (None, NO_TIME) and time_name not in columns:
         raise DataError(f"{str(path)!r}: no time column {time_name!r}; {_available(path, columns)}")
     missing = [c for c in signals if c not in columns]
@@ -109,7 +117,7 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
     total = len(columns[output_name])
     for end in (sl.start, sl.stop):
         if end is not None and not -total <= end <= total:
-            raise ParameterError(f"--rows {rows}: {end} is beyond the file's {total} data rows "
+            raise ParameterError(f"--rows '{rows}': {end} is beyond the file's {total} data rows "
                                  f"(rows 0 to {total - 1}, or -{total} to -1 from the end)")
     cols = {k: np.asarray(v)[sl] for k, v in columns.items()}
     n = len(cols[output_name])
@@ -549,6 +557,8 @@ def cmd_identify(args) -> int:
 
     def report():  # the summary is printed before the model file is committed: a run that cannot
         # print it (a full disk behind stdout) or is stopped meanwhile leaves no file behind
+        if sys.stdout is None:  # started with stdout closed (>&-): nothing to print to
+            return
         try:
             sys.stdout.write(text)
             sys.stdout.flush()

@@ -226,9 +226,14 @@ class PWARX(BaseEstimator):
         if isinstance(rounds, bool) or not isinstance(rounds, (int, np.integer)) or rounds < 0:
             raise ParameterError(f"refinement_rounds must be an int >= 0, got {rounds!r}")
         seed = self.random_state
-        if not (seed is None or isinstance(seed, np.random.Generator)
-                or (isinstance(seed, (int, np.integer)) and not isinstance(seed, bool) and seed >= 0)):
-            raise ParameterError(f"random_state must be None or an int >= 0, got {seed!r}")
+        try:  # what numpy's default_rng takes: None, an int >= 0, a SeedSequence, a Generator, ...
+            if isinstance(seed, (bool, np.bool_, str, bytes, float)):
+                raise TypeError
+            np.random.default_rng(seed)
+        except (TypeError, ValueError):
+            shown = seed if isinstance(seed, (bool, str, bytes, float, int)) else type(seed).__name__
+            raise ParameterError(f"random_state must be None, an int >= 0 or a numpy Generator or SeedSequence, "
+                                 f"got {shown!r}") from None
 
     def _segmenter(self):
         from sklearn.base import clone
@@ -264,7 +269,7 @@ class PWARX(BaseEstimator):
         ``{signal name: unit}`` kept for plots and exports. Returns ``self``.
         """
         if isinstance(X, IODataset):
-            uniform = X.uniform_sample_time("the dataset's time")
+            uniform = X.uniform_sample_time("the dataset's time", LIBRARY_REMEDY)
             if sample_time is None:
                 sample_time = uniform
         if sample_time is not None and (isinstance(sample_time, bool) or not np.isfinite(sample_time)
@@ -274,10 +279,12 @@ class PWARX(BaseEstimator):
         u, yy, names, oname = self._signals(X, y, input_names, output_name)
         n_inputs = u.shape[1]
         names = tuple(names) if names is not None else tuple(f"u{j + 1}" for j in range(n_inputs))
-        _check_names(names, oname or "y", n_inputs)
+        if oname is None:  # the output unnamed: "y", unless an input has that name
+            oname = "y" if "y" not in names else "y_out"
+        _check_names(names, oname, n_inputs)
         breaks = _check_breaks(breaks, yy.shape[0])
         structure = RegressorStructure.create(self.output_order, self.input_order, self.input_delay,
-                                              n_inputs, self.constant, names, oname or "y", self.output_powers,
+                                              n_inputs, self.constant, names, oname, self.output_powers,
                                               *power_scaling(yy))
         structure.check_length(yy.shape[0])
         for j, name in enumerate(names):
@@ -401,7 +408,7 @@ class PWARX(BaseEstimator):
             if y is not None:
                 raise ParameterError("pass either an IODataset or (inputs, output), not both")
             known = getattr(self, "sample_time_", None)
-            X.uniform_sample_time("the dataset's time")
+            X.uniform_sample_time("the dataset's time", "resample the data")
             if known is not None and X.n_samples > 1 and abs(X.sample_time - known) > 0.01 * known:
                 raise DataError(f"the data's sample time {X.sample_time:.6g} s differs from the model's {known:.6g} s: "
                                 f"its lags would mean other delays; resample the data or refit")
@@ -590,6 +597,10 @@ class PWARX(BaseEstimator):
         return est
 
 
+LIBRARY_REMEDY = ("resample it, or fit the arrays with breaks at the gaps: "
+                  "fit(data.inputs, data.output, breaks=[...])")
+
+
 def _check_names(names, output_name, n_inputs):
     """The inputs' names: one per input column, distinct, none the output's (a regressor column is
     chosen by name: ``partition_columns``, ``--partition-column``, the model file)."""
@@ -614,7 +625,8 @@ def _check_breaks(breaks, n):
     out = []
     for b in breaks:
         if isinstance(b, bool) or not isinstance(b, (int, np.integer)) or not 0 < b < n:
-            raise ParameterError(f"breaks must be sample positions between 1 and {n - 1}, got {b!r}")
+            shown = b.item() if isinstance(b, np.generic) else b
+            raise ParameterError(f"breaks must be sample positions between 1 and {n - 1}, got {shown!r}")
         out.append(int(b))
     return tuple(sorted(set(out)))
 

@@ -55,11 +55,15 @@ def umask_mode(base: int = 0o666) -> int:
 def check_output_path(path: str | os.PathLike, what: str = "--out") -> Path:
     """Refuse an output that is a folder, a symbolic link, a device or a FIFO (never replaced)."""
     target = Path(path)
-    if target.is_symlink():
+    try:
+        link = target.is_symlink()
+        mode = target.stat().st_mode if target.exists() else None
+    except OSError as error:  # a name too long, a folder we may not search
+        raise DataError(f"{what} {str(target)!r}: cannot write there ({error.strerror or error})") from None
+    if link:
         raise DataError(f"{what} {str(target)!r}: is a symbolic link; hwpts never replaces a link, "
                         f"give the path of a regular file")
-    if target.exists():
-        mode = target.stat().st_mode
+    if mode is not None:
         if stat.S_ISDIR(mode):
             raise DataError(f"{what} {str(target)!r}: is a folder, expected a file path")
         if not stat.S_ISREG(mode):
@@ -84,7 +88,7 @@ def _temporary_head(target: Path, end: str) -> str:
     name stays within 255 bytes, a long but valid name was refused), then the process id."""
     room = 255 - len(end.encode()) - 40  # ".", ".", the pid, mkstemp's 8 characters, a margin
     name = target.name
-    while len(name.encode()) > room:
+    while name and len(name.encode()) > room:
         name = name[:-1]
     return f".{name}."
 

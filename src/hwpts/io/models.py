@@ -67,11 +67,21 @@ def _settings(model) -> dict:
     for key in SETTINGS:
         value = params.get(key)
         if key == "segmentation" and not isinstance(value, str):
-            value = getattr(value, "name", None)
+            instance, value = value, getattr(value, "name", None)
+            if hasattr(instance, "get_params") and not params.get("segmentation_params"):
+                # an instance's own parameters travel as the named method's parameters
+                own = _jsonable(instance.get_params(deep=False))
+                try:
+                    json.dumps(own, allow_nan=False)
+                    out["segmentation_params"] = own or None
+                except (TypeError, ValueError):
+                    pass
         elif key == "hyperplanes" and value is not None:
             value = [_hyperplane_text(h) for h in value]
         elif key == "random_state" and not (value is None or isinstance(value, (int, np.integer))):
             continue
+        if key == "segmentation_params" and key in out and not value:
+            continue  # taken from the segmenter instance above
         value = _jsonable(value)
         try:
             json.dumps(value, allow_nan=False)
@@ -234,8 +244,7 @@ def _check_structure_types(st: dict) -> None:
     twice = sorted({x for x in names if names.count(x) > 1})
     if twice:
         raise DataError(f"structure.input_names names {twice[0]!r} twice")
-    if st["output_name"] in names:
-        raise DataError(f"structure.output_name {st['output_name']!r} is also one of structure.input_names")
+
     if not isinstance(st["constant"], bool):
         raise DataError(f"structure.constant must be true or false, got {st['constant']!r}"[:200])
     powers = st.get("output_powers")
@@ -332,7 +341,7 @@ def model_from_dict(doc: dict):
             raise DataError(f"regions[{i}].model is 'zero' but its theta is not all zeros")
         if kind == "constant" and np.any(th[:-1] != 0):
             raise DataError(f"regions[{i}].model is 'constant' but its theta has nonzero regressor coefficients")
-        if not structure.constant and th[-1] != 0:
+        if not structure.constant and kind == "affine" and th[-1] != 0:  # a 'constant' region has its level
             raise DataError(f"structure.constant is false but regions[{i}].theta ends with the offset {th[-1]:.6g}")
         count = reg.get("n_train_samples", 0)
         if not _is_int(count) or not 0 <= count < 2 ** 53:
@@ -373,7 +382,7 @@ def model_from_dict(doc: dict):
     model.region_counts_ = np.array([int(r.get("n_train_samples", 0)) for r in regions], dtype=np.int64)
     if isinstance(seg, dict) and isinstance(seg.get("method"), str):
         model.segmentation = seg["method"]
-    settings = doc.get("settings", {})  # optional (files written before it refit with the defaults)
+    settings = doc.get("settings") or {}  # optional (files written before it refit with the defaults)
     if not isinstance(settings, dict):
         raise DataError(f"settings must be a JSON object, got {type(settings).__name__}")
     unknown = sorted(set(settings) - set(SETTINGS))

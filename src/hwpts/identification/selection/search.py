@@ -542,7 +542,9 @@ class PWARXSearch(BaseEstimator):
         from hwpts.dataset import IODataset
 
         if isinstance(X, IODataset):
-            uniform = X.uniform_sample_time("the dataset's time")
+            from hwpts.identification.pwarx import LIBRARY_REMEDY
+
+            uniform = X.uniform_sample_time("the dataset's time", LIBRARY_REMEDY)
             if sample_time is None:
                 sample_time = uniform
         if sample_time is not None and (isinstance(sample_time, bool) or not np.isfinite(sample_time)
@@ -569,6 +571,8 @@ class PWARXSearch(BaseEstimator):
         max_lag = max(self._max_lag(base, o) for o in order_grid)
         splits = self._splits(n, max_lag)
         for number, (_, test) in enumerate(splits, start=1):
+            if np.ptp(yy) == 0:
+                break  # a constant record: the estimator's own fit says so
             if test.size > max_lag and np.ptp(yy[test[max_lag:]]) == 0:
                 raise DataError(f"PWARXSearch: the output is constant over held-out block {number} of {len(splits)} "
                                 f"(samples {test[0]}-{test[-1]}): no fit % can score a model there; give the model "
