@@ -128,3 +128,8 @@ def test_a_mat_matrix_column_and_a_variable_of_its_name_are_refused(tmp_path):
     savemat(tmp_path / "clash.mat", {"u": np.ones((10, 2)), "u_1": -np.ones(10), "y": np.arange(10.0)})
     with pytest.raises(DataError, match="column 1 of matrix 'u' and the variable 'u_1'"):
         read_table(tmp_path / "clash.mat")
+
+
+def test_a_text_variable_does_not_clash_with_a_matrix_column(tmp_path):
+    savemat(tmp_path / "ok.mat", {"u": np.ones((10, 2)), "u_1": "a note", "y": np.arange(10.0)})
+    assert sorted(read_table(tmp_path / "ok.mat")) == ["u_1", "u_2", "y"]

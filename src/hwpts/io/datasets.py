@@ -376,7 +376,9 @@ def _read_mat(p: Path) -> dict[str, np.ndarray]:
                 arr = arr.T
             for j in range(arr.shape[1]):
                 column = f"{name}_{j + 1}"
-                if column in raw or column in out:  # a variable of that name: neither may shadow the other
+                other = raw.get(column)
+                numeric = other is not None and not isinstance(other, str) and np.asarray(other).dtype.kind in "biuf"
+                if numeric or column in out:  # a numeric variable of that name: neither may shadow the other
                     raise DataError(f"{str(p)!r}: column {j + 1} of matrix {name!r} and the variable {column!r} "
                                     f"would both be the column {column!r}; rename one of them")
                 out[column] = arr[:, j]
