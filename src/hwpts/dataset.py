@@ -109,6 +109,15 @@ class IODataset:
         steps = np.diff(self.time)
         dt = float(f"{float(np.median(steps)):.12g}")  # 0.01, not 0.009999999999999787 from the time column's rounding
         worst = float(np.max(np.abs(steps - dt)))
+        if worst > 0.01 * dt and np.array_equal(self.time, self.time.astype(np.float32)):
+            # a single-precision time axis (MATLAB single, float32 Parquet): a uniform grid rounded
+            # to float32 has steps off by its spacing at the largest time (at 1000 s, 6e-5 s: 60 % of
+            # a 10 kHz step); it is uniform when rounding the least-squares grid gives it back
+            k = np.arange(self.n_samples) - 0.5 * (self.n_samples - 1)
+            slope = float(np.dot(k, self.time - self.time.mean()) / np.dot(k, k))
+            grid = self.time.mean() + k * slope
+            if np.max(np.abs(grid.astype(np.float32) - self.time)) <= np.spacing(np.float32(np.max(np.abs(self.time)))):
+                return float(f"{slope:.6g}")
         if worst > 0.01 * dt:
             row = int(np.argmax(np.abs(steps - dt))) + 1
             raise DataError(f"{what} is not uniformly sampled (step {dt:.6g} s, but {steps[row - 1]:.6g} s at row "

@@ -218,3 +218,17 @@ def test_seeds_numpy_takes_and_an_input_named_y():
     assert model.output_name_ == "y_out" and model.structure_.feature_names == ["y_out(k-1)", "y(k-1)"]
     with pytest.raises(ParameterError, match="input name 'y' is the output's name"):
         PWARX(1, 1, 1).fit(u, y, input_names=["y"], output_name="y")
+
+
+def test_a_single_precision_time_axis_is_uniform_and_its_gap_is_not():
+    """A 10 kHz axis stored in float32 near 1000 s has steps of 6e-5 or 1.2e-4 s (its rounding):
+    uniform at 1e-4 s; a gap in it is still refused."""
+    from hwpts.dataset import IODataset
+
+    n = 10_000
+    u = np.random.default_rng(0).uniform(-1, 1, (n, 1))
+    t = (1000.0 + np.arange(n) * 1e-4).astype(np.float32).astype(float)
+    assert IODataset(t, u, np.cumsum(u[:, 0]), ["u"], "y").uniform_sample_time() == 1e-4
+    t[5000:] += 0.5
+    with pytest.raises(DataError, match="not uniformly sampled"):
+        IODataset(t, u, np.cumsum(u[:, 0]), ["u"], "y").uniform_sample_time()
