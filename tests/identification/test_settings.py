@@ -232,3 +232,16 @@ def test_a_single_precision_time_axis_is_uniform_and_its_gap_is_not():
     t[5000:] += 0.5
     with pytest.raises(DataError, match="not uniformly sampled"):
         IODataset(t, u, np.cumsum(u[:, 0]), ["u"], "y").uniform_sample_time()
+
+
+def test_one_stable_linear_mode_is_not_called_diverged_far_beyond_its_training_range():
+    rng = np.random.default_rng(0)
+    u = rng.uniform(-1, 1, 1000)
+    y = np.zeros(1000)
+    for k in range(1, 1000):
+        y[k] = 0.9 * y[k - 1] + 0.1 * u[k - 1]
+    model = PWARX(1, 1, 1, n_regions=1, segmentation="average").fit(u[:, None], y)
+    big = 100 * y  # the same system driven 100x harder: exact, and 100x the training range
+    assert model.score(100 * u[:, None], big) > 99.99
+    switched = PWARX(1, 1, 1, segmentation="threshold", random_state=0).fit(*two_modes())
+    assert np.isfinite(switched.divergence_band()[1])  # switching stable modes can still diverge
