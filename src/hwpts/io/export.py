@@ -82,6 +82,12 @@ def _py_array(a) -> str:
     return "np.array(" + repr(arr.tolist()) + ", dtype=float).reshape(" + repr(arr.shape) + ")"
 
 
+def _docstring_text(text: str) -> str:
+    """``text`` safe inside a triple-quoted docstring: its ``repr`` without the outer quotes (line
+    breaks and backslashes escaped), with every double quote escaped too."""
+    return repr(str(text))[1:-1].replace('"', '\\"')
+
+
 def control_script(doc: dict, generator: str, model_name: str) -> str:
     """A Python module that builds one python-control ``StateSpace`` per mode (``MODES``).
 
@@ -90,8 +96,10 @@ def control_script(doc: dict, generator: str, model_name: str) -> str:
     """
     dt = doc["sample_time_s"]
     inputs = [*doc["inputs"], "offset"]
+    # the names go into the docstring as a Python literal's text: a file name holding quotes or a
+    # line break (a crafted '"""' then code) cannot end the docstring or add a line of code
     lines = [
-        f'"""python-control systems of the PWARX model {model_name} ({generator}).',
+        f'"""python-control systems of the PWARX model {_docstring_text(model_name)} ({_docstring_text(generator)}).',
         "",
         "Mode i: x(k+1) = A x(k) + [B e] [u(k); 1],  y(k) = C x(k) + [D c] [u(k); 1]  (paper eq. 7),",
         "active where H_i r(k) + g_i <= 0 over the regressor r named REGRESSOR_NAMES (eq. 9).",
