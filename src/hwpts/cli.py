@@ -71,6 +71,10 @@ def _check_outputs(args) -> None:
             if source is not None and os.path.realpath(source) == target:
                 raise UsageError(f"--{flag} {str(out)!r} is the {name} file {str(source)!r}: writing it would "
                                  f"destroy the input; choose another output path")
+            if source is not None and os.path.realpath(source).startswith(target.rstrip(os.sep) + os.sep):
+                # an output folder is replaced as a whole: the input inside it would be deleted
+                raise UsageError(f"--{flag} {str(out)!r} holds the {name} file {str(source)!r}: the folder is "
+                                 f"replaced as a whole, which would delete it; choose another output folder")
 
 
 def _interrupt(signum, frame):  # pragma: no cover - exercised in a subprocess test

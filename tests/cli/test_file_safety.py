@@ -489,3 +489,26 @@ def test_a_closed_stdout_still_writes_the_model_and_a_long_suffix_is_an_error(tm
     assert (tmp_path / ("x." + "b" * 215)).read_text() == "{}"
     with pytest.raises(DataError, match="cannot write there"):
         write_text_atomic(tmp_path / ("x." + "b" * 300), "{}")  # too long for the file system
+
+
+def test_run_folders_never_swallow_their_input_a_link_or_the_current_folder(tmp_path, monkeypatch, capsys):
+    """control run --model DIR/model.json --out DIR deleted the model (the folder is replaced as a
+    whole); a link as --out was replaced by a folder and left behind hidden; --out . did the work
+    and then failed, leaving a staging folder."""
+    from hwpts.identification.synthetic import make_system  # noqa: F401 - keeps the import list honest
+
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "model.json").write_text("{}")
+    capsys.readouterr()
+    assert main(["control", "run", "--scenario", "pump-step", "--model", str(run / "model.json"),
+                 "--controllers", "pi", "--duration", "1", "--out", str(run)]) == 2
+    assert "holds the model file" in capsys.readouterr().err
+    assert (run / "model.json").read_text() == "{}"
+    (tmp_path / "link").symlink_to(run)
+    assert main(["reproduce", "--quick", "--out", str(tmp_path / "link")]) == 2
+    assert "is a symbolic link" in capsys.readouterr().err and (tmp_path / "link").is_symlink()
+    monkeypatch.chdir(run)
+    assert main(["reproduce", "--quick", "--out", "."]) == 2
+    assert "is (or holds) the current folder" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["link", "run"]

@@ -140,7 +140,23 @@ def test_a_new_run_replaces_an_earlier_one_as_a_whole(quick_run, tmp_path):
     out = tmp_path / "results"
     shutil.copytree(quick_run, out)
     (out / "figures" / "fig99_from_an_older_version.png").write_bytes(b"old")
+    written = json.loads((out / ".hwpts-files").read_text())  # the earlier run wrote that figure
+    (out / ".hwpts-files").write_text(json.dumps([*written, "figures/fig99_from_an_older_version.png"]))
     assert main(["reproduce", "--quick", "--out", str(out), "--seed", "1"]) == 0
     assert not (out / "figures" / "fig99_from_an_older_version.png").exists()
     assert json.loads((out / "summary.json").read_text())["seed"] == 1
     assert np.all([p.name != "fig99_from_an_older_version.png" for p in (out / "figures").iterdir()])
+
+
+def test_a_file_the_earlier_run_did_not_write_is_not_deleted(quick_run, tmp_path, capsys):
+    """A run replaces its folder as a whole: the user's own notes in an earlier run's folder were
+    deleted with it; now the run is refused and nothing is touched."""
+    import shutil
+
+    out = tmp_path / "results"
+    shutil.copytree(quick_run, out)
+    (out / "notes.txt").write_text("mine")
+    capsys.readouterr()
+    assert main(["reproduce", "--quick", "--out", str(out)]) == 2
+    assert "also holds files it did not write (notes.txt)" in capsys.readouterr().err
+    assert (out / "notes.txt").read_text() == "mine"

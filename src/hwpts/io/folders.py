@@ -17,6 +17,14 @@ from hwpts.io.atomic import commit_allowed, point_of_no_return, umask_mode
 def check_replaceable(path: str | os.PathLike, schema: str, marker: str = "summary.json") -> None:
     """Refuse a target that exists and is not empty, unless it is an earlier run of ``schema``."""
     out = Path(path)
+    if out.is_symlink():
+        raise DataError(f"--out {str(out)!r}: is a symbolic link; hwpts never replaces a link, give the path "
+                        f"of a folder")
+    here = os.path.realpath(os.getcwd())
+    where = os.path.realpath(out)
+    if here == where or here.startswith(where.rstrip(os.sep) + os.sep):
+        raise DataError(f"--out {str(out)!r}: is (or holds) the current folder, which a run replaces as a whole; "
+                        f"give a folder beside it")
     if not out.exists():
         return
     if not out.is_dir():
@@ -32,6 +40,23 @@ def check_replaceable(path: str | os.PathLike, schema: str, marker: str = "summa
             f"--out {str(out)!r}: the folder exists and holds files that are not an earlier hwpts run "
             f"(no {marker} with schema {schema!r}); choose another folder or empty it"
         )
+    try:  # the files the earlier run wrote (runs before the list existed: not checked)
+        written = set(json.loads((out / MANIFEST).read_text(encoding="utf-8")))
+    except (OSError, ValueError, TypeError):
+        return
+    extra = sorted(name for name in _files(out) if name not in written and name != MANIFEST)
+    if extra:
+        shown = ", ".join(extra[:3]) + (f" and {len(extra) - 3} more" if len(extra) > 3 else "")
+        raise DataError(f"--out {str(out)!r}: an earlier run's folder that also holds files it did not write "
+                        f"({shown}); a run replaces the folder as a whole: move them or choose another folder")
+
+
+MANIFEST = ".hwpts-files"  # the files a run wrote in its folder (JSON list of relative paths)
+
+
+def _files(folder: Path) -> list[str]:
+    """Relative paths of the files and folders under ``folder``."""
+    return [str(p.relative_to(folder)) for p in folder.rglob("*")]
 
 
 PID_FILE = ".hwpts-pid"  # the process writing a staging folder
@@ -79,6 +104,7 @@ def staged_folder(path: str | os.PathLike, schema: str):
         try:
             commit_allowed()
             (stage / PID_FILE).unlink()
+            (stage / MANIFEST).write_text(json.dumps(sorted(_files(stage))), encoding="utf-8")
             os.chmod(stage, umask_mode(0o777))
         except BaseException:
             shutil.rmtree(stage, ignore_errors=True)
