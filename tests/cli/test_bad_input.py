@@ -345,6 +345,14 @@ CASES = [
     (["control", "run", "--scenario", "pump-step", "--model", f"{W}/model.json", "--out", f"{W}/c"],
      "--model '{ws}/model.json': the model's inputs must be the valve voltage"),
     (["control", "run", "--scenario", "pump-step", "--controllers", "magic", "--out", f"{W}/c"], "magic"),
+    # found by a review (2026-11-26): a traceback below one loop sample or at 1e300 s, no bound on
+    # the study's size
+    (["control", "run", "--scenario", "pump-step", "--duration", "0.005", "--out", f"{W}/c"],
+     "argument --duration: expected seconds between 0.1"),
+    (["control", "run", "--scenario", "pump-step", "--duration", "1e300", "--out", f"{W}/c"], "argument --duration"),
+    (["control", "study", "--plants", "99999999999999999999", "--seeds", "1", "--out", f"{W}/c"],
+     "argument --plants: expected a whole number from 1 to 10000"),
+    (["control", "study", "--plants", "2", "--seeds", "1", "--workers", "1000", "--out", f"{W}/c"], "argument --workers"),
     (["control", "run", "--scenario", "pump-step", "--setpoint", "1e9", "--out", f"{W}/c"], "--setpoint"),
     (["control", "run", "--scenario", "pump-step", "--duration", "-1", "--out", f"{W}/c"], "--duration"),
     (["control", "run", "--scenario", "pump-step", "--seed", "x", "--out", f"{W}/c"], "--seed"),

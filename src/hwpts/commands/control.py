@@ -19,6 +19,27 @@ def _positive(text):
     return value
 
 
+MAX_DURATION_S = 86_400.0  # one day at the 10 ms loop: 8.6e6 samples a record
+MIN_DURATION_S = 0.1  # ten samples of the 10 ms loop
+
+
+def _duration(text):
+    value = _positive(text)
+    if not MIN_DURATION_S <= value <= MAX_DURATION_S:
+        raise argparse.ArgumentTypeError(f"expected seconds between {MIN_DURATION_S:g} (ten samples of the 10 ms "
+                                         f"loop) and {MAX_DURATION_S:g} (a day), got {text!r}")
+    return value
+
+
+def _bounded_count(top):
+    def parse(text):
+        value = _count(text)
+        if value > top:
+            raise argparse.ArgumentTypeError(f"expected a whole number from 1 to {top}, got {text!r}")
+        return value
+    return parse
+
+
 def _count(text):
     value = non_negative_int(text)
     if value < 1:
@@ -48,7 +69,7 @@ def register(subparsers) -> None:
                    help="half-width of the valve's play the model's valve input was compensated with [V] "
                    "(default: read off the sweeps when identifying, else 0.25)")
     r.add_argument("--setpoint", type=finite_float, default=1000.0, metavar="RPM", help="speed set-point (default 1000)")
-    r.add_argument("--duration", type=_positive, default=None, metavar="S", help="shorter or longer record than the "
+    r.add_argument("--duration", type=_duration, default=None, metavar="S", help="shorter or longer record than the "
                    "scenario's own (turbulence: 600 s)")
     r.add_argument("--seed", type=non_negative_int, default=0, metavar="N", help="seed of wind and sensor noise (default 0)")
     r.add_argument("--out", required=True, metavar="DIR", help="output folder (an earlier run there is replaced)")
@@ -58,10 +79,10 @@ def register(subparsers) -> None:
                         "and wind seeds, mapped over a Dask cluster: a local one by default, an existing scheduler "
                         "with --scheduler. Writes DIR/results.parquet (one row per plant, seed and controller) and "
                         "DIR/summary.json (share of plants on which each controller meets the turbulence targets).")
-    st.add_argument("--plants", type=_count, required=True, metavar="N", help="number of plants (plant 0 is nominal)")
-    st.add_argument("--seeds", type=_count, required=True, metavar="M", help="wind seeds per plant")
+    st.add_argument("--plants", type=_bounded_count(10_000), required=True, metavar="N", help="number of plants (plant 0 is nominal)")
+    st.add_argument("--seeds", type=_bounded_count(10_000), required=True, metavar="M", help="wind seeds per plant")
     st.add_argument("--scheduler", metavar="ADDRESS", help="address of a running Dask scheduler, e.g. tcp://127.0.0.1:8786")
-    st.add_argument("--workers", type=_count, default=None, metavar="N", help="workers of the local cluster (default: one per core)")
+    st.add_argument("--workers", type=_bounded_count(256), default=None, metavar="N", help="workers of the local cluster (default: one per core)")
     st.add_argument("--scenario", default="turbulence-a", metavar="NAME", help="scenario (default turbulence-a)")
     st.add_argument("--controllers", default="pi,scheduled,mpc", metavar="A,B,...",
                     help="controllers (default pi,scheduled,mpc; pi is the baseline of the targets)")
@@ -69,7 +90,7 @@ def register(subparsers) -> None:
     st.add_argument("--model-sample-time", type=_positive, default=None, metavar="S",
                     help="the model's sample period (default: the one in the model file, else 0.05 s)")
     st.add_argument("--hysteresis-width", type=finite_float, default=None, metavar="V", help="the model's play half-width [V]")
-    st.add_argument("--duration", type=_positive, default=None, metavar="S", help="record length (default: the scenario's, 600 s)")
+    st.add_argument("--duration", type=_duration, default=None, metavar="S", help="record length (default: the scenario's, 600 s)")
     st.add_argument("--seed", type=non_negative_int, default=0, metavar="N", help="seed of the plant draws (default 0)")
     st.add_argument("--out", required=True, metavar="DIR", help="output folder (an earlier study there is replaced)")
     st.set_defaults(handler=study_command)
@@ -116,6 +137,14 @@ def _model_bank(args):
             from hwpts.errors import ParameterError
 
             raise ParameterError(f"--model-sample-time {dt:g}: the model file says it was fitted at {known:g} s")
+        from hwpts.control.scenarios import SAMPLE_TIME_S
+        from hwpts.errors import DataError
+
+        steps = dt / SAMPLE_TIME_S  # the model runs every `steps` samples of the 10 ms loop
+        if not (0.999 <= steps <= 1000 and abs(steps - round(steps)) <= 1e-6 * steps):
+            raise DataError(f"--model {str(args.model)!r}: its sample time {dt:g} s is not a whole multiple of the "
+                            f"control loop's {SAMPLE_TIME_S:g} s (up to 10 s); identify it from data sampled at "
+                            f"a multiple of 10 ms")
         return model, model_to_dict(model), dt, half_width, f"file {args.model}"
     print("identifying the model bank as 'hwpts reproduce' does (method 'paper') ...", file=sys.stderr)
     model, r_hat, sample_time = identify_model_bank(args.seed)
