@@ -122,6 +122,40 @@ def summarize(rows: list[dict], controllers, n_plants: int, n_seeds: int) -> dic
     return out
 
 
+def _connect(Client, scheduler: str):
+    """A client of the Dask scheduler at ``scheduler`` (``tcp://host:port`` or ``host:port``), or one
+    line saying why not. The whole handshake has a deadline: a server that accepts the connection
+    and then says nothing (not a scheduler) held the run for as long as it stayed open."""
+    import re
+    import threading
+
+    if not re.fullmatch(r"(tcp://)?[A-Za-z0-9_.\-\[\]:]+:\d{1,5}", scheduler):
+        raise DataError(f"--scheduler {scheduler!r}: expected a Dask scheduler's address tcp://HOST:PORT")
+    result: dict = {}
+
+    def attempt():
+        try:
+            result["client"] = Client(scheduler, timeout=f"{CONNECT_TIMEOUT_S}s")
+        except BaseException as error:  # noqa: BLE001 - reported below as one line
+            result["error"] = error
+
+    worker = threading.Thread(target=attempt, daemon=True)
+    worker.start()
+    worker.join(2 * CONNECT_TIMEOUT_S)
+    if "client" in result:
+        return result["client"]
+    error = result.get("error")
+    if error is None:
+        why = f"no scheduler answered within {2 * CONNECT_TIMEOUT_S:g} s"
+    elif isinstance(error, MemoryError):
+        why = "what answered is not a Dask scheduler"
+    elif isinstance(error, KeyboardInterrupt):
+        raise error
+    else:
+        why = f"{type(error).__name__}: {str(error).splitlines()[0] if str(error) else ''}"
+    raise DataError(f"--scheduler {scheduler!r}: cannot reach a Dask scheduler there ({why})")
+
+
 def run_study(model_doc: dict, model_sample_time: float, half_width: float, n_plants: int, n_seeds: int,
               controllers, scenario_name: str = "turbulence-a", study_seed: int = 0, scheduler: str | None = None,
               duration=None, progress: bool = False, n_workers: int | None = None) -> StudyResult:
@@ -138,10 +172,7 @@ def run_study(model_doc: dict, model_sample_time: float, half_width: float, n_pl
     cluster = None
     try:
         if scheduler:
-            try:
-                client = Client(scheduler, timeout=f"{CONNECT_TIMEOUT_S}s")
-            except (OSError, TimeoutError, ValueError) as error:
-                raise DataError(f"--scheduler {scheduler!r}: cannot reach a Dask scheduler there ({error})") from None
+            client = _connect(Client, scheduler)
         else:
             cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
                                    dashboard_address=":0")
