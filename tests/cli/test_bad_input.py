@@ -354,7 +354,7 @@ CASES = [
      "argument --plants: expected a whole number from 1 to 10000"),
     (["control", "study", "--plants", "2", "--seeds", "1", "--workers", "1000", "--out", f"{W}/c"], "argument --workers"),
     (["control", "study", "--plants", "1", "--seeds", "1", "--scheduler", "tls://127.0.0.1:1", "--out", f"{W}/c"],
-     "--scheduler 'tls://127.0.0.1:1': expected a Dask scheduler's address tcp://HOST:PORT"),
+     "argument --scheduler: expected a Dask scheduler's address tcp://HOST:PORT, got 'tls://127.0.0.1:1'"),
     (["control", "run", "--scenario", "pump-step", "--setpoint", "1e9", "--out", f"{W}/c"], "--setpoint"),
     (["control", "run", "--scenario", "pump-step", "--duration", "-1", "--out", f"{W}/c"], "--duration"),
     (["control", "run", "--scenario", "pump-step", "--seed", "x", "--out", f"{W}/c"], "--seed"),

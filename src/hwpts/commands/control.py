@@ -40,6 +40,14 @@ def _bounded_count(top):
     return parse
 
 
+def _address(text):
+    from hwpts.control.study import is_address
+
+    if not is_address(text):
+        raise argparse.ArgumentTypeError(f"expected a Dask scheduler's address tcp://HOST:PORT, got {text!r}")
+    return text
+
+
 def _count(text):
     value = non_negative_int(text)
     if value < 1:
@@ -81,7 +89,7 @@ def register(subparsers) -> None:
                         "DIR/summary.json (share of plants on which each controller meets the turbulence targets).")
     st.add_argument("--plants", type=_bounded_count(10_000), required=True, metavar="N", help="number of plants (plant 0 is nominal)")
     st.add_argument("--seeds", type=_bounded_count(10_000), required=True, metavar="M", help="wind seeds per plant")
-    st.add_argument("--scheduler", metavar="ADDRESS", help="address of a running Dask scheduler, e.g. tcp://127.0.0.1:8786")
+    st.add_argument("--scheduler", type=_address, metavar="ADDRESS", help="address of a running Dask scheduler, e.g. tcp://127.0.0.1:8786")
     st.add_argument("--workers", type=_bounded_count(256), default=None, metavar="N", help="workers of the local cluster (default: one per core)")
     st.add_argument("--scenario", default="turbulence-a", metavar="NAME", help="scenario (default turbulence-a)")
     st.add_argument("--controllers", default="pi,scheduled,mpc", metavar="A,B,...",

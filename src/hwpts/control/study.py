@@ -122,14 +122,20 @@ def summarize(rows: list[dict], controllers, n_plants: int, n_seeds: int) -> dic
     return out
 
 
+def is_address(text: str) -> bool:
+    """Whether ``text`` is a scheduler address hwpts connects to: ``tcp://HOST:PORT`` or ``HOST:PORT``."""
+    import re
+
+    return bool(re.fullmatch(r"(tcp://)?[A-Za-z0-9_.\-\[\]:]+:\d{1,5}", str(text)))
+
+
 def _connect(Client, scheduler: str):
     """A client of the Dask scheduler at ``scheduler`` (``tcp://host:port`` or ``host:port``), or one
     line saying why not. The whole handshake has a deadline: a server that accepts the connection
     and then says nothing (not a scheduler) held the run for as long as it stayed open."""
-    import re
     import threading
 
-    if not re.fullmatch(r"(tcp://)?[A-Za-z0-9_.\-\[\]:]+:\d{1,5}", scheduler):
+    if not is_address(scheduler):
         raise DataError(f"--scheduler {scheduler!r}: expected a Dask scheduler's address tcp://HOST:PORT")
     result: dict = {}
 
