@@ -76,3 +76,13 @@ def test_unreachable_scheduler_is_one_line(tmp_path, capsys, paper_model_file, m
                  "--model", str(paper_model_file), "--scheduler", "tcp://127.0.0.1:9", "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err
     assert code == 2 and err.count("\n") == 1 and "--scheduler" in err
+
+
+def test_the_pi_baseline_is_always_run(tmp_path, capsys, paper_model_file):
+    """Without pi in --controllers the '30 % below PI' target was dropped in silence: the same
+    controller met the targets or not as pi was listed. pi is added, and said so."""
+    out = tmp_path / "study"
+    assert main(["control", "study", "--plants", "1", "--seeds", "1", "--duration", "3", "--controllers", "scheduled",
+                 "--model", str(paper_model_file), "--out", str(out)]) == 0
+    assert "pi added to --controllers" in capsys.readouterr().err
+    assert set(json.loads((out / "summary.json").read_text())["controllers"]) == {"pi", "scheduled"}
