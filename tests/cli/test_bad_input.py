@@ -353,6 +353,8 @@ CASES = [
     (["control", "study", "--plants", "99999999999999999999", "--seeds", "1", "--out", f"{W}/c"],
      "argument --plants: expected a whole number from 1 to 10000"),
     (["control", "study", "--plants", "2", "--seeds", "1", "--workers", "1000", "--out", f"{W}/c"], "argument --workers"),
+    (["plant", "steady-state", "--valve-voltage", "11", "--pump-speed", "700"], "--valve-voltage: valve voltage must be"),
+    (["plant", "sweep", "--out", f"{W}/s.csv", "--pump-speeds=-100:1000:3"], "--pump-speeds: pump speed must be"),
     (["control", "study", "--plants", "1", "--seeds", "1", "--scheduler", "tls://127.0.0.1:1", "--out", f"{W}/c"],
      "argument --scheduler: expected a Dask scheduler's address tcp://HOST:PORT, got 'tls://127.0.0.1:1'"),
     (["control", "run", "--scenario", "pump-step", "--setpoint", "1e9", "--out", f"{W}/c"], "--setpoint"),

@@ -70,7 +70,10 @@ def register(subparsers) -> None:
 def steady_state_command(args) -> int:
     """``hwpts plant steady-state``: print one steady operating point of the test bed as JSON."""
     from hwpts.plant import PlantParameters, steady_state
+    from hwpts.plant.parameters import check_input_ranges
 
+    check_input_ranges(args.valve_voltage, 0.0, where="--valve-voltage: ")  # the option named in the message
+    check_input_ranges(0.0, args.pump_speed, where="--pump-speed: ")
     result = steady_state(PlantParameters.paper(), args.valve_voltage, args.pump_speed, branch=args.branch)
     print(json.dumps({
         "valve_voltage_v": args.valve_voltage,
@@ -102,6 +105,10 @@ def sweep_command(args) -> int:
         )
     voltages = np.linspace(*args.voltages)
     pumps = np.linspace(*args.pump_speeds)
+    from hwpts.plant.parameters import check_input_ranges
+
+    check_input_ranges(voltages, 0.0, where="--voltages: ")
+    check_input_ranges(0.0, pumps, where="--pump-speeds: ")
     result = sweep(PlantParameters.paper(), voltages, pumps)
     write_table(args.out, sweep_columns(result))
     print(
