@@ -64,7 +64,7 @@ def _edit(path, fn, fix_checksum=True):
     (lambda d: d["regions"][0].update(n_train_samples=10 ** 30), True, r"n_train_samples must be an int >= 0"),
     (lambda d: d["training"]["input_ranges"][0].reverse(), True, r"input_ranges must be \[low, high\] pairs"),
     (lambda d: d["structure"].update(input_names=["u1", "u1"]), True, "structure.input_names names 'u1' twice"),
-    (lambda d: d["structure"].update(nk=[20000] * len(d["structure"]["nk"])), True, "largest lag .* is not below"),
+    (lambda d: d["structure"].update(nk=[20000] * len(d["structure"]["nk"])), True, "largest lag .* is beyond"),
 ])
 def test_bad_model_files(model_file, edit, fix, match):
     _edit(model_file, edit, fix)

@@ -375,10 +375,10 @@ def model_from_dict(doc: dict):
     if np.any(in_ranges[:, 0] > in_ranges[:, 1]):
         raise DataError("training.input_ranges must be [low, high] pairs, got a low above its high")
     n_samples = training.get("n_samples")
-    if _is_int(n_samples) and structure.max_lag >= n_samples:
+    if _is_int(n_samples) and structure.max_lag > n_samples:  # (a model from parts has n_samples = max_lag)
         # a fit needs more samples than lags: orders edited beyond the record (nk 20000 on 4,000
         # samples took gigabytes to export)
-        raise DataError(f"the orders' largest lag ({structure.max_lag}) is not below training.n_samples "
+        raise DataError(f"the orders' largest lag ({structure.max_lag}) is beyond training.n_samples "
                         f"({n_samples}): no fit on that record could have them")
     seg = doc.get("segmentation") or {}
     model = PWARX.from_parts(structure, partition, np.array(theta), kinds, out_range, in_ranges,
