@@ -214,17 +214,13 @@ class PWARX(BaseEstimator):
     def _check_settings(self):
         """One line naming the setting, what it takes and what it got, before any fit (the orders,
         regions and rows are checked where they are used)."""
+        from hwpts.identification.settings import check_bool, check_count, check_number
+
         for name in ("constant", "polish", "sparse_partition"):
-            if not isinstance(getattr(self, name), (bool, np.bool_)):
-                raise ParameterError(f"{name} must be True or False, got {getattr(self, name)!r}")
-        for name, strict in (("ridge", False), ("classifier_C", True)):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
-                    or not np.isfinite(value) or value < 0 or (strict and value == 0):
-                raise ParameterError(f"{name} must be a number {'> 0' if strict else '>= 0'}, got {value!r}")
-        rounds = self.refinement_rounds
-        if isinstance(rounds, bool) or not isinstance(rounds, (int, np.integer)) or rounds < 0:
-            raise ParameterError(f"refinement_rounds must be an int >= 0, got {rounds!r}")
+            check_bool(getattr(self, name), name)
+        check_number(self.ridge, "ridge")
+        check_number(self.classifier_C, "classifier_C", strict=True)
+        check_count(self.refinement_rounds, "refinement_rounds", 0)
         seed = self.random_state
         try:  # what numpy's default_rng takes: None, an int >= 0, a SeedSequence, a Generator, ...
             if isinstance(seed, (bool, np.bool_, str, bytes, float)):

@@ -33,6 +33,7 @@ import numpy as np
 
 from hwpts.errors import ParameterError
 from hwpts.identification.segmentation.base import SegmentationResult, Segmenter, kmeans_labels, standardize
+from hwpts.identification.settings import check_count, check_number
 
 
 def _fit_thetas(Phi, ys, labels, s, ridge):
@@ -263,9 +264,9 @@ class AlternatingSegmenter(Segmenter):
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
         """Labels from alternating assignment and least squares with restarts (see the module docstring)."""
         self._check_regions(n_regions, X.shape[0])
-        self._check_count("n_restarts", 1, allow=("auto",))
-        self._check_number("gamma", 0.0)
-        self._check_count("max_iter", 1)
+        check_count(self.n_restarts, "n_restarts", 1, "alternating: ", allow=("auto",))
+        check_number(self.gamma, "gamma", owner="alternating: ")
+        check_count(self.max_iter, "max_iter", 1, "alternating: ")
         try:
             anneal = tuple(float(a) for a in self.anneal)
         except (TypeError, ValueError):

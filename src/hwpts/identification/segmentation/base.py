@@ -60,27 +60,6 @@ class Segmenter(BaseEstimator):
         """Assign the regressor rows ``X`` with targets ``y`` to ``n_regions`` regions; returns a :class:`SegmentationResult` (labels, and a partition when the method defines one)."""
         raise NotImplementedError
 
-    def _check_count(self, name, low, allow=()):
-        """``ParameterError`` unless the parameter ``name`` is an int >= ``low`` (or in ``allow``)."""
-        value = getattr(self, name)
-        if any(value is a or (isinstance(value, str) and value == a) for a in allow):
-            return
-        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
-            extra = "".join(f" or {a!r}" for a in allow)
-            raise ParameterError(f"{self.name}: {name} must be an int >= {low}{extra}, got {value!r}")
-
-    def _check_number(self, name, low=0.0, strict=False):
-        """``ParameterError`` unless the parameter ``name`` is a finite number >= ``low`` (> when ``strict``)."""
-        value = getattr(self, name)
-        ok = (not isinstance(value, bool) and isinstance(value, (int, float, np.integer, np.floating))
-              and np.isfinite(value) and (value > low if strict else value >= low))
-        if not ok:
-            raise ParameterError(f"{self.name}: {name} must be a number {'>' if strict else '>='} {low:g}, got {value!r}")
-
-    def _check_bool(self, name):
-        if not isinstance(getattr(self, name), (bool, np.bool_)):
-            raise ParameterError(f"{self.name}: {name} must be True or False, got {getattr(self, name)!r}")
-
     def _check_regions(self, n_regions, n_rows):
         if not isinstance(n_regions, (int, np.integer)) or n_regions < 1:
             raise ParameterError(f"n_regions must be an int >= 1, got {n_regions!r}")

@@ -28,6 +28,7 @@ from hwpts.identification.segmentation.base import (
     standardize,
 )
 from hwpts.identification.threads import single_threaded
+from hwpts.identification.settings import check_count
 
 
 _FEATURE_CACHE = BoundedCache(24)  # fingerprint of (X, y), n_neighbors -> local features (see local_features)
@@ -88,8 +89,8 @@ class ClusteringSegmenter(Segmenter):
         """Labels from clustering the local-model features of Ferrari-Trecate et al. (see the module docstring)."""
         self._check_regions(n_regions, X.shape[0])
         if self.n_neighbors is not None:
-            self._check_count("n_neighbors", 2)
-        self._check_count("n_init", 1)
+            check_count(self.n_neighbors, "n_neighbors", 2, "clustering: ")
+        check_count(self.n_init, "n_init", 1, "clustering: ")
         p = X.shape[1] + 1
         c = self.n_neighbors if self.n_neighbors is not None else max(2 * p, p + 3)
         theta, m, V, c = local_features(X, y, c)

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from hwpts.identification.segmentation.base import SegmentationResult, Segmenter, kmeans_labels, standardize
+from hwpts.identification.settings import check_bool, check_count
 
 
 class KMeansSegmenter(Segmenter):
@@ -32,8 +33,8 @@ class KMeansSegmenter(Segmenter):
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
         """Labels from k-means on the standardised regressors."""
         self._check_regions(n_regions, X.shape[0])
-        self._check_count("n_init", 1)
-        self._check_bool("include_output")
+        check_count(self.n_init, "n_init", 1, "kmeans: ")
+        check_bool(self.include_output, "include_output", "kmeans: ")
         Z = standardize(np.column_stack([X, y]) if self.include_output else X)
         labels = kmeans_labels(Z, n_regions, rng, self.n_init)
         return SegmentationResult(labels, n_regions, refine=False)

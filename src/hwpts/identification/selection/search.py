@@ -555,24 +555,16 @@ class PWARXSearch(BaseEstimator):
         self._names = (names, oname)
         n = yy.shape[0]
         self._check_params()
-        if not isinstance(self.scoring, str) or self.scoring not in SCORINGS:
-            raise ParameterError(f"PWARXSearch: scoring must be one of {list(SCORINGS)}, got {self.scoring!r}")
         # "auto" is decided after the ARX stage of the adaptive search; until then the free run ranks
         self.scoring_ = "one_step" if self.scoring == "one_step" else "free_run"
-        if self.shared_modes not in (True, False, "auto"):
-            raise ParameterError(f"PWARXSearch: shared_modes must be True, False or 'auto', got {self.shared_modes!r}")
         self._powers = self._powers_to_try()
-        if self.order_ranking not in ("neighbours", "arx"):
-            raise ParameterError(f"PWARXSearch: order_ranking must be 'neighbours' or 'arx', got {self.order_ranking!r}")
         self.modes_gate_ = None
         self.orders_ranking_ = None
         self.input_delays_ = None
         order_grid = self._order_grid(base, u, yy)
         max_lag = max(self._max_lag(base, o) for o in order_grid)
         splits = self._splits(n, max_lag)
-        for number, (_, test) in enumerate(splits, start=1):
-            if np.ptp(yy) == 0:
-                break  # a constant record: the estimator's own fit says so
+        for number, (_, test) in enumerate(splits if np.ptp(yy) > 0 else [], start=1):  # (constant: the fit says so)
             if test.size > max_lag and np.ptp(yy[test[max_lag:]]) == 0:
                 raise DataError(f"PWARXSearch: the output is constant over held-out block {number} of {len(splits)} "
                                 f"(samples {test[0]}-{test[-1]}): no fit % can score a model there; give the model "
@@ -742,34 +734,32 @@ class PWARXSearch(BaseEstimator):
 
     def _check_params(self):
         """One line naming the parameter, what it takes and what it got, before any fit."""
-        def number(value, low, strict=False):
-            return (not isinstance(value, bool) and isinstance(value, (int, float, np.integer, np.floating))
-                    and np.isfinite(value) and (value > low if strict else value >= low))
+        from hwpts.identification.settings import check_bool, check_count, check_number, is_count
 
-        def count(value, low):
-            return not isinstance(value, bool) and isinstance(value, (int, np.integer)) and value >= low
-
+        owner = "PWARXSearch: "
         for name in ("tolerance", "n_standard_errors", "refit_margin"):
-            value = getattr(self, name)
-            if not number(value, 0):
-                raise ParameterError(f"PWARXSearch: {name} must be a number >= 0, got {value!r}")
-        for name, low in (("n_orders", 1), ("patience", 1)):
-            if not count(getattr(self, name), low):
-                raise ParameterError(f"PWARXSearch: {name} must be an int >= {low}, got {getattr(self, name)!r}")
-        if self.max_regions != "auto" and not count(self.max_regions, 1):
+            check_number(getattr(self, name), name, owner=owner)
+        for name in ("n_orders", "patience"):
+            check_count(getattr(self, name), name, 1, owner)
+        if self.max_regions != "auto" and not is_count(self.max_regions, 1):
             raise ParameterError(f"PWARXSearch: max_regions must be 'auto' or an int >= 1, got {self.max_regions!r}")
         if not (isinstance(self.try_polish, (bool, np.bool_)) or (isinstance(self.try_polish, str)
                                                                     and self.try_polish == "auto")):
             raise ParameterError(f"PWARXSearch: try_polish must be True, False or 'auto', got {self.try_polish!r}")
-        if not isinstance(self.progress, (bool, np.bool_)):
-            raise ParameterError(f"PWARXSearch: progress must be True or False, got {self.progress!r}")
+        check_bool(self.progress, "progress", owner)
         cv = self.cv
-        if not (cv is None or count(cv, 2) or (hasattr(cv, "split") and not isinstance(cv, (str, bytes)))):
+        if not (cv is None or is_count(cv, 2) or (hasattr(cv, "split") and not isinstance(cv, (str, bytes)))):
             raise ParameterError(f"PWARXSearch: cv must be None, an int >= 2 (blocks) or a splitter with split(), "
                                  f"got {cv!r}")
         if self.n_jobs is not None and (isinstance(self.n_jobs, bool) or not isinstance(self.n_jobs, (int, np.integer))
                                         or self.n_jobs == 0):
             raise ParameterError(f"PWARXSearch: n_jobs must be None or a non-zero int (-1: every core), got {self.n_jobs!r}")
+        if not isinstance(self.scoring, str) or self.scoring not in SCORINGS:
+            raise ParameterError(f"PWARXSearch: scoring must be one of {list(SCORINGS)}, got {self.scoring!r}")
+        if self.shared_modes not in (True, False, "auto"):
+            raise ParameterError(f"PWARXSearch: shared_modes must be True, False or 'auto', got {self.shared_modes!r}")
+        if self.order_ranking not in ("neighbours", "arx"):
+            raise ParameterError(f"PWARXSearch: order_ranking must be 'neighbours' or 'arx', got {self.order_ranking!r}")
         self._methods()
 
     def _powers_to_try(self) -> tuple[int, ...]:
