@@ -97,7 +97,6 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
     except DataError:
         if time_name is not None or not candidates:
             raise
-        columns = read_table(path, signals)
         readable = []
         for name in candidates:  # a conventionally named column that holds text is no time axis ...
             try:
@@ -106,8 +105,7 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
             except DataError:
                 if numeric_share(path, name) >= 0.9:  # ... but one of numbers with a mistyped cell is broken
                     raise
-        if readable:
-            columns = read_table(path, [*signals, *readable])
+        columns = read_table(path, [*signals, *readable])  # (a bad signal column raises its own error here)
     if time_name not in (None, NO_TIME) and time_name not in columns:
         raise DataError(f"{str(path)!r}: no time column {time_name!r}; {_available(path, columns)}")
     missing = [c for c in signals if c not in columns]

@@ -60,29 +60,20 @@ def _hyperplane_text(h) -> str:
 
 
 def _settings(model) -> dict:
-    """The JSON-able settings of :data:`SETTINGS` (one that is not, e.g. a segmenter instance's
-    own object or a numpy Generator, is left out and keeps its default on loading)."""
+    """The JSON-able settings of :data:`SETTINGS` (one that is not, e.g. a numpy Generator as the
+    seed, is left out and keeps its default on loading). A segmenter instance is kept as its name
+    with its own parameters as the method's ``segmentation_params``."""
     params = model.get_params(deep=False)
+    segmenter = params["segmentation"]
+    if not isinstance(segmenter, str):
+        params["segmentation"] = getattr(segmenter, "name", None)
+        if not params.get("segmentation_params") and hasattr(segmenter, "get_params"):
+            params["segmentation_params"] = segmenter.get_params(deep=False) or None
+    if params.get("hyperplanes") is not None:
+        params["hyperplanes"] = [_hyperplane_text(h) for h in params["hyperplanes"]]
     out = {}
     for key in SETTINGS:
-        value = params.get(key)
-        if key == "segmentation" and not isinstance(value, str):
-            instance, value = value, getattr(value, "name", None)
-            if hasattr(instance, "get_params") and not params.get("segmentation_params"):
-                # an instance's own parameters travel as the named method's parameters
-                own = _jsonable(instance.get_params(deep=False))
-                try:
-                    json.dumps(own, allow_nan=False)
-                    out["segmentation_params"] = own or None
-                except (TypeError, ValueError):
-                    pass
-        elif key == "hyperplanes" and value is not None:
-            value = [_hyperplane_text(h) for h in value]
-        elif key == "random_state" and not (value is None or isinstance(value, (int, np.integer))):
-            continue
-        if key == "segmentation_params" and key in out and not value:
-            continue  # taken from the segmenter instance above
-        value = _jsonable(value)
+        value = _jsonable(params.get(key))
         try:
             json.dumps(value, allow_nan=False)
         except (TypeError, ValueError):
