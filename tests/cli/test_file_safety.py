@@ -495,8 +495,6 @@ def test_run_folders_never_swallow_their_input_a_link_or_the_current_folder(tmp_
     """control run --model DIR/model.json --out DIR deleted the model (the folder is replaced as a
     whole); a link as --out was replaced by a folder and left behind hidden; --out . did the work
     and then failed, leaving a staging folder."""
-    from hwpts.identification.synthetic import make_system  # noqa: F401 - keeps the import list honest
-
     run = tmp_path / "run"
     run.mkdir()
     (run / "model.json").write_text("{}")

@@ -33,7 +33,13 @@ from hwpts.identification.partition import (
     drop_empty_regions,
     fit_linear_partition,
 )
-from hwpts.identification.regressors import RegressorStructure, dense_real, power_scaling, validate_signals
+from hwpts.identification.regressors import (
+    RegressorStructure,
+    default_input_names,
+    dense_real,
+    power_scaling,
+    validate_signals,
+)
 from hwpts.identification.segmentation import make_segmenter
 from hwpts.identification.simulation import SimulationResult, k_step_pwarx, one_step_pwarx, simulate_pwarx
 from hwpts.identification.statespace import mode_state_space
@@ -274,7 +280,7 @@ class PWARX(BaseEstimator):
         self._check_settings()
         u, yy, names, oname = self._signals(X, y, input_names, output_name)
         n_inputs = u.shape[1]
-        names = tuple(names) if names is not None else tuple(f"u{j + 1}" for j in range(n_inputs))
+        names = tuple(names) if names is not None else default_input_names(n_inputs)
         if oname is None:  # the output unnamed: "y", unless an input has that name
             oname = "y" if "y" not in names else "y_out"
         _check_names(names, oname, n_inputs)
@@ -404,9 +410,9 @@ class PWARX(BaseEstimator):
             if y is not None:
                 raise ParameterError("pass either an IODataset or (inputs, output), not both")
             known = getattr(self, "sample_time_", None)
-            X.uniform_sample_time("the dataset's time", "resample the data")
-            if known is not None and X.n_samples > 1 and abs(X.sample_time - known) > 0.01 * known:
-                raise DataError(f"the data's sample time {X.sample_time:.6g} s differs from the model's {known:.6g} s: "
+            dt = X.uniform_sample_time("the dataset's time", "resample the data")
+            if known is not None and dt is not None and abs(dt - known) > 0.01 * known:
+                raise DataError(f"the data's sample time {dt:.6g} s differs from the model's {known:.6g} s: "
                                 f"its lags would mean other delays; resample the data or refit")
             X, y = _select_columns(X.inputs, X.input_names, self.input_names_), X.output
         else:
@@ -666,7 +672,7 @@ def _select_columns(u, names, wanted) -> np.ndarray:
     names = tuple(names)
     if names == tuple(wanted):
         return u
-    unnamed = tuple(f"u{j + 1}" for j in range(len(wanted)))
+    unnamed = default_input_names(len(wanted))
     if tuple(wanted) == unnamed and len(names) == len(wanted) and not set(names) & set(unnamed):
         # a model fitted on arrays (its inputs unnamed) given a DataFrame: its columns in order,
         # as scikit-learn takes them, with a warning

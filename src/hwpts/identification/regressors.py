@@ -75,6 +75,11 @@ def check_output_powers(value) -> tuple[int, ...]:
     return tuple(sorted(int(v) for v in items))
 
 
+def default_input_names(n_inputs: int) -> tuple[str, ...]:
+    """The inputs' names when none are given: ``u1``, ``u2``, ..."""
+    return tuple(f"u{j + 1}" for j in range(n_inputs))
+
+
 def power_scaling(output) -> tuple[float, float]:
     """``(c, s)`` of the power terms for a training ``output``: its mean and standard deviation
     (1 for a constant output)."""
@@ -128,8 +133,7 @@ class RegressorStructure:
         nk_t = as_order_tuple(nk, n_inputs, "nk (input delay)", 0)
         if na == 0 and sum(nb_t) == 0:
             raise ParameterError("na=0 and nb=0 for every input leave an empty regressor")
-        names = tuple(input_names) if input_names is not None else tuple(
-            f"u{j + 1}" for j in range(n_inputs))
+        names = tuple(input_names) if input_names is not None else default_input_names(n_inputs)
         if len(names) != n_inputs:
             raise ParameterError(f"{len(names)} input names for {n_inputs} inputs")
         powers = check_output_powers(output_powers)
