@@ -86,3 +86,50 @@ def test_the_pi_baseline_is_always_run(tmp_path, capsys, paper_model_file):
                  "--model", str(paper_model_file), "--out", str(out)]) == 0
     assert "pi added to --controllers" in capsys.readouterr().err
     assert set(json.loads((out / "summary.json").read_text())["controllers"]) == {"pi", "scheduled"}
+
+
+def _spawned_children(pid: int) -> list[int]:
+    """Process ids of the multiprocessing children (Dask workers) of ``pid`` (Linux /proc)."""
+    import pathlib
+
+    found = []
+    for status in pathlib.Path("/proc").glob("[0-9]*/status"):
+        try:
+            fields = dict(line.split(":\t", 1) for line in status.read_text().splitlines() if ":\t" in line)
+            cmdline = (status.parent / "cmdline").read_bytes()
+        except OSError:
+            continue
+        if fields.get("PPid", "").strip() == str(pid) and b"multiprocessing.spawn" in cmdline:
+            found.append(int(status.parent.name))
+    return found
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc to see the workers start")
+def test_ctrl_c_at_the_terminal_stops_a_study_in_one_line(tmp_path, paper_model_file):
+    """A terminal's Ctrl-C reaches the whole process group, Dask's worker processes included: they
+    leave it to hwpts (no traceback from any of them), and the run ends as any interrupted run."""
+    import os
+    import signal
+
+    proc = subprocess.Popen([sys.executable, "-m", "hwpts", "control", "study", "--plants", "50", "--seeds", "2",
+                             "--duration", "60", "--workers", "2", "--model", str(paper_model_file),
+                             "--out", str(tmp_path / "study")],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True, cwd=tmp_path)
+    try:
+        deadline = time.monotonic() + 120
+        while len(_spawned_children(proc.pid)) < 2 and time.monotonic() < deadline and proc.poll() is None:
+            time.sleep(0.2)
+        assert len(_spawned_children(proc.pid)) == 2, "the local cluster's workers never started"
+        time.sleep(3)  # the workers are running tasks
+        os.killpg(proc.pid, signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+    text = err.decode()
+    assert proc.returncode == 130
+    assert "Traceback" not in text and "WARNING" not in text, text
+    assert text.strip().splitlines()[-1] == "hwpts: interrupted"
+    assert not (tmp_path / "study").exists()

@@ -162,6 +162,24 @@ def _connect(Client, scheduler: str):
     raise DataError(f"--scheduler {scheduler!r}: cannot reach a Dask scheduler there ({why})")
 
 
+def _local_cluster(LocalCluster, n_workers: int | None):
+    """A local Dask cluster that leaves Ctrl-C to hwpts. A Ctrl-C at the terminal reaches the
+    whole process group: each worker process printed its own traceback and the nanny its warnings
+    about cancelled tasks and killed workers. The workers start with SIGINT ignored (a disposition
+    an executed process inherits, and which Python and asyncio then leave alone), so only hwpts
+    sees it and closes the cluster; the cluster's own log stays at errors. A Ctrl-C in the second
+    or two the cluster takes to start is ignored (press it again); SIGTERM is not affected."""
+    import logging
+    import signal
+
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        return LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
+                            dashboard_address=":0", silence_logs=logging.ERROR)
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 def run_study(model_doc: dict, model_sample_time: float, half_width: float, n_plants: int, n_seeds: int,
               controllers, scenario_name: str = "turbulence-a", study_seed: int = 0, scheduler: str | None = None,
               duration=None, progress: bool = False, n_workers: int | None = None) -> StudyResult:
@@ -180,8 +198,7 @@ def run_study(model_doc: dict, model_sample_time: float, half_width: float, n_pl
         if scheduler:
             client = _connect(Client, scheduler)
         else:
-            cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
-                                   dashboard_address=":0")
+            cluster = _local_cluster(LocalCluster, n_workers)
             client = Client(cluster)
         try:
             doc = client.scatter(model_doc, broadcast=True)
