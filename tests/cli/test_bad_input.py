@@ -21,6 +21,7 @@ from hwpts.io.models import checksum
 
 FIT = ["--input", "u1", "--input", "u2", "--output", "y"]
 FIXED = [*FIT, "--na", "2", "--nb", "2", "--segmentation", "average"]
+ARABIC_THREE = "\u0663"  # Python's float() and int() read it as 3
 
 
 def _edited_model(doc: dict, edit) -> str:
@@ -92,6 +93,7 @@ def workspace(tmp_path_factory):
         "typotime.csv": "time_s,u1,u2,y\n" + "".join(f"{'15.0.1' if i == 5 else i * 0.1},{i % 4},{i % 3},{i}\n"
                                                       for i in range(40)),
         "underscore.csv": "u1,u2,y\n" + "".join(f"{'1_000' if i == 5 else i % 4},{i % 3},{i}\n" for i in range(40)),
+        "arabic_digit.csv": "u1,u2,y\n" + "".join(f"{ARABIC_THREE if i == 5 else i % 4},{i % 3},{i}\n" for i in range(40)),
         "twotime.csv": "time,t_s,u1,u2,y\n" + "".join(f"12:00:{i:02d},{i * 0.1},{i % 4},{i % 3},{i % 5}\n"
                                                       for i in range(40)),
         "bigtime.csv": "time_s,u1,u2,y\n" + "".join(f"{i * 1e6},{i % 4},{i % 3},{i % 5}\n" for i in range(40)),
@@ -139,6 +141,14 @@ CASES = [
     (["validate", f"{W}/model.json", f"{W}/typotime.csv"], "line 7, column 'time_s': expected a number, got '15.0.1'"),
     (["identify", f"{W}/underscore.csv", *FIXED, "--out", f"{W}/m.json"], "got '1_000'"),
     (["identify", f"{W}/data.csv", *FIXED, "--rows", "1_0:50", "--out", f"{W}/m.json"], "--rows expects START:STOP"),
+    # numbers as one rule reads them everywhere (hwpts.text): Python's int and float also take
+    # "1_0" and non-ASCII digits ("\u0663" is an Arabic-Indic three), a command line and a CSV do not
+    (["identify", f"{W}/arabic_digit.csv", *FIXED, "--out", f"{W}/m.json"], "line 7, column 'u1': expected a number"),
+    (["identify", f"{W}/data.csv", *FIT, "--na", "1_0", "--nb", "2", "--out", f"{W}/m.json"], "--na: expected a whole number, got '1_0'"),
+    (["identify", f"{W}/data.csv", *FIT, "--na", "\u0663", "--nb", "2", "--out", f"{W}/m.json"], "--na: expected a whole number"),
+    (["identify", f"{W}/data.csv", *FIT, "--na", "2", "--nb", "2", "--regions", "1_0", "--out", f"{W}/m.json"],
+     "--regions expects an int"),
+    (["plant", "steady-state", "--valve-voltage", "2.4", "--pump-speed", "7_00"], "--pump-speed: expected a number, got '7_00'"),
     # a text column named "time" beside a numeric t_s: the t_s axis is read, at another rate than the model's
     (["validate", f"{W}/model.json", f"{W}/twotime.csv"], "sample time 0.1 s"),
     (["identify", f"{W}/data.csv", *FIXED, "--rows", "0:100000", "--out", f"{W}/m.json"], "--rows '0:100000': 100000 is beyond"),

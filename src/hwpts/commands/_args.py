@@ -8,11 +8,13 @@ import json
 import math
 from pathlib import Path
 
+from hwpts.text import plain_float, plain_int
+
 
 def finite_float(text: str) -> float:
     """A finite real number."""
     try:
-        value = float(text)
+        value = plain_float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
     if not math.isfinite(value):
@@ -28,10 +30,18 @@ def non_negative_float(text: str) -> float:
     return value
 
 
+def integer(text: str) -> int:
+    """An integer (its range is checked where it is used)."""
+    try:
+        return plain_int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+
+
 def non_negative_int(text: str) -> int:
     """An integer >= 0."""
     try:
-        value = int(text)
+        value = plain_int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
     if value < 0:
@@ -42,7 +52,7 @@ def non_negative_int(text: str) -> int:
 def positive_int(text: str) -> int:
     """An integer >= 1."""
     try:
-        value = int(text)
+        value = plain_int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
     if value < 1:
@@ -57,7 +67,7 @@ def grid(text: str) -> tuple[float, float, int]:
         raise argparse.ArgumentTypeError(f"expected START:STOP:N, got {text!r}")
     start, stop = finite_float(parts[0]), finite_float(parts[1])
     try:
-        count = int(parts[2])
+        count = plain_int(parts[2])
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected a whole number of points N in START:STOP:N, got {parts[2]!r}") from None
     if count < 1:

@@ -10,12 +10,13 @@ import numpy as np
 
 from hwpts.commands._args import json_text
 from hwpts.errors import DataError, ParameterError, SimulationError
+from hwpts.text import plain_int
 
 
 def _int_list(text: str, name: str):
     """``"4"`` -> 4, ``"4,2"`` -> [4, 2] (one per input)."""
     try:
-        values = [int(v) for v in str(text).split(",")]
+        values = [plain_int(v) for v in str(text).split(",")]
     except ValueError:
         raise ParameterError(f"--{name} expects an int or comma-separated ints (one per input), got {text!r}") from None
     return values[0] if len(values) == 1 else values
@@ -29,7 +30,7 @@ def _output_powers(text: str):
     if text in ("auto", "none"):
         return "auto" if text == "auto" else ()
     try:
-        return check_output_powers([int(v) for v in text.split(",")])
+        return check_output_powers([plain_int(v) for v in text.split(",")])
     except (ValueError, ParameterError):
         raise ParameterError(f"--output-powers: expected 'auto', 'none' or distinct powers 2-{MAX_POWER} such as "
                              f"2,3; got {text!r}") from None
@@ -42,10 +43,8 @@ def _rows(text: str | None):
     try:
         if len(parts) != 2:
             raise ValueError
-        if "_" in str(text):  # int() reads "1_0" as 10
-            raise ValueError
-        start = int(parts[0]) if parts[0].strip() else None
-        stop = int(parts[1]) if parts[1].strip() else None
+        start = plain_int(parts[0]) if parts[0].strip() else None
+        stop = plain_int(parts[1]) if parts[1].strip() else None
     except ValueError:
         raise ParameterError(f"--rows expects START:STOP (Python slice, e.g. 0:5000 or -1001:), got {text!r}") from None
     return slice(start, stop)
@@ -476,7 +475,7 @@ def cmd_identify(args) -> int:
         n_regions = "auto"
     else:
         try:
-            n_regions = int(regions)
+            n_regions = plain_int(regions)
         except ValueError:
             raise ParameterError(f"--regions expects an int >= 1 or 'auto', got {regions!r}") from None
         if n_regions < 1:
@@ -792,7 +791,7 @@ def register(subparsers):
     """Add the ``identify``, ``validate`` and ``predict`` sub-commands to ``subparsers``."""
     import argparse
 
-    from hwpts.commands._args import file_with_suffix, non_negative_float, non_negative_int, positive_int
+    from hwpts.commands._args import file_with_suffix, integer, non_negative_float, non_negative_int, positive_int
 
     class ModeAction(argparse.Action):
         def __call__(self, parser, namespace, values, option_string=None):
@@ -807,7 +806,7 @@ def register(subparsers):
     p.add_argument("data", metavar="DATA", help="data file: .csv, .parquet or .mat")
     p.add_argument("--input", metavar="COL", action="append", required=True, help="input column (repeat for several)")
     p.add_argument("--output", metavar="COL", required=True, help="output column")
-    p.add_argument("--na", type=int, default=None, metavar="N",
+    p.add_argument("--na", type=integer, default=None, metavar="N",
                    help="output order (default: chosen on the data, 0-4)")
     p.add_argument("--nb", default=None, metavar="N",
                    help="input order, an int or one per input: 4,4 (default: chosen on the data, 1-4)")
@@ -823,7 +822,7 @@ def register(subparsers):
                    help="a*x1 + b*x2 + c >= 0 on the first two inputs, or 'a,b,c@col1,col2' on named "
                         "regressor columns; repeat for a decision list (m hyperplanes, m+1 regions); write "
                         "--hyperplane=-1,0,2.8 when the first coefficient is negative")
-    p.add_argument("--zero-region", type=int, action="append", default=[], metavar="I",
+    p.add_argument("--zero-region", type=integer, action="append", default=[], metavar="I",
                    help="region I (1-based) is the zero mode y = 0 (paper eq. 18)")
     p.add_argument("--partition-column", action="append", default=[], metavar="COL",
                    help="regressor column the region classifier may use, e.g. 'y(k-1)' (repeat; default all)")

@@ -16,6 +16,7 @@ import numpy as np
 
 from hwpts.errors import DataError
 from hwpts.io.atomic import atomic_path, write_text_atomic
+from hwpts.text import plain_float
 
 SUPPORTED_SUFFIXES = (".csv", ".parquet", ".mat")
 
@@ -125,13 +126,13 @@ def numeric_share(path: str | os.PathLike, column: str) -> float:
         return 0.0
     j = header.index(column)
     cells = [r[j].strip() for r in rows[1:] if j < len(r) and r[j].strip()]
-    return sum(is_number(c) and "_" not in c for c in cells) / len(cells) if cells else 0.0
+    return sum(is_number(c) for c in cells) / len(cells) if cells else 0.0
 
 
 def is_number(text: str) -> bool:
-    """Whether ``text`` reads as a float (a header cell that is a number: no header row)."""
+    """Whether ``text`` reads as a number (a header cell that is a number: no header row)."""
     try:
-        float(text)
+        plain_float(text)
     except ValueError:
         return False
     return True
@@ -175,9 +176,7 @@ def _read_csv_python(p: Path, delimiter: str = ",", columns=None) -> dict[str, n
         for j in wanted:
             cell = row[j]
             try:
-                if "_" in cell:  # Python's float() reads "1_000" as 1000; no CSV writer means that
-                    raise ValueError
-                values[i - 2, j] = float(cell)
+                values[i - 2, j] = plain_float(cell)
             except ValueError:
                 raise DataError(
                     f"{str(p)!r} line {i}, column {header[j]!r}: expected a number, got {cell.strip()!r}"

@@ -24,6 +24,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from hwpts.errors import DataError, ParameterError
+from hwpts.text import plain_float
 
 __all__ = ["RegionPartition", "fit_linear_partition", "hyperplane_partition", "Hyperplane"]
 
@@ -261,9 +262,9 @@ class Hyperplane:
         body, at, cols = str(text).partition("@")
         fields = [v.strip() for v in body.split(",")]
         try:
-            if any(not v or "_" in v for v in fields):  # an empty field would shift the others
+            if any(not v for v in fields):  # an empty field would shift the others
                 raise ValueError
-            numbers = [float(v) for v in fields]
+            numbers = [plain_float(v) for v in fields]
         except ValueError:
             raise ParameterError(
                 f"hyperplane {text!r}: expected numbers 'a,b,c' meaning a*x1 + b*x2 + c >= 0"
