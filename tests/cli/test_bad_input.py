@@ -149,6 +149,8 @@ CASES = [
     (["identify", f"{W}/data.csv", *FIT, "--na", "2", "--nb", "2", "--regions", "1_0", "--out", f"{W}/m.json"],
      "--regions expects an int"),
     (["plant", "steady-state", "--valve-voltage", "2.4", "--pump-speed", "7_00"], "--pump-speed: expected a number, got '7_00'"),
+    # 1e308 r/min of sensor noise overflowed to inf and was reported as a bad output column
+    (["plant", "simulate", "--case", "case1", "--out", f"{W}/sim.csv", "--noise-std", "1e308"], "--noise-std: expected r/min"),
     # a text column named "time" beside a numeric t_s: the t_s axis is read, at another rate than the model's
     (["validate", f"{W}/model.json", f"{W}/twotime.csv"], "sample time 0.1 s"),
     (["identify", f"{W}/data.csv", *FIXED, "--rows", "0:100000", "--out", f"{W}/m.json"], "--rows '0:100000': 100000 is beyond"),

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import json
 import sys
 
@@ -61,10 +62,19 @@ def register(subparsers) -> None:
     source.add_argument("--inputs", metavar="FILE.csv",
                         help="CSV with columns time_s, valve_voltage_v [V], pump_speed_rpm [r/min, the command]")
     p.add_argument("--out", type=file_with_suffix(".csv", ".parquet", stdout=True), required=True, metavar="FILE.csv", help="output table: .csv, .parquet, or - for CSV on standard output")
-    p.add_argument("--noise-std", type=non_negative_float, default=None, metavar="RPM",
+    p.add_argument("--noise-std", type=_noise_std, default=None, metavar="RPM",
                    help="speed sensor noise standard deviation [r/min] (default: the test bed's 2.0)")
     p.add_argument("--seed", type=non_negative_int, default=0, metavar="N", help="noise seed (default 0)")
     p.set_defaults(handler=simulate_command)
+
+
+def _noise_std(text):
+    from hwpts.plant.testbed import MAX_NOISE_STD_RPM
+
+    value = non_negative_float(text)
+    if value > MAX_NOISE_STD_RPM:
+        raise argparse.ArgumentTypeError(f"expected r/min from 0 to {MAX_NOISE_STD_RPM:g}, got {text!r}")
+    return value
 
 
 def steady_state_command(args) -> int:

@@ -23,6 +23,7 @@ OUTPUT_NAME = "motor_a_speed_rpm"
 DEFAULT_SAMPLE_TIME = 0.01
 """Sample period of the test bed's data logger [s] (10 ms; the paper does not state its own)."""
 
+MAX_NOISE_STD_RPM = 1e6  # a thousand times the speeds measured; 1e308 overflowed to inf in the samples
 DEFAULT_NOISE_STD_RPM = 2.0
 """Standard deviation of the speed sensors' noise [r/min] (assumed: ~0.1 % of full scale)."""
 
@@ -50,8 +51,9 @@ class TestBed:
     def __post_init__(self):
         if not (np.isfinite(self.sample_time) and self.sample_time > 0):
             raise ParameterError(f"sample_time must be a positive number of seconds, got {self.sample_time!r}")
-        if not (np.isfinite(self.noise_std_rpm) and self.noise_std_rpm >= 0):
-            raise ParameterError(f"noise_std_rpm must be a finite number >= 0, got {self.noise_std_rpm!r}")
+        if not (np.isfinite(self.noise_std_rpm) and 0 <= self.noise_std_rpm <= MAX_NOISE_STD_RPM):
+            raise ParameterError(f"noise_std_rpm must be a number from 0 to {MAX_NOISE_STD_RPM:g} r/min, "
+                                 f"got {self.noise_std_rpm!r}")
 
     def run(self, time, valve_voltage, pump_speed_command, seed: int | None = 0, **simulate_options):
         """Simulate and measure: returns (IODataset, PlantResponse).
