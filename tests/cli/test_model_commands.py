@@ -489,7 +489,7 @@ def test_identify_output_powers(tmp_path, capsys):
     assert json.loads(capsys.readouterr().out)["fit_percent"] > 95
     assert main(["export", str(tmp_path / "fixed.json"), "--format", "json", "--out", str(tmp_path / "ss.json")]) == 2
     err = capsys.readouterr().err.strip()
-    assert "needs affine modes" in err and len(err.splitlines()) == 1 and not (tmp_path / "ss.json").exists()
+    assert "needs affine modes" in err and "fixed.json" in err and len(err.splitlines()) == 1 and not (tmp_path / "ss.json").exists()
 
 
 def test_identify_output_powers_name_a_partition_column_and_count_in_the_region_limit(tmp_path, capsys):

@@ -58,7 +58,10 @@ def cmd_export(args) -> int:
         raise ParameterError(f"--out {str(args.out)!r}: --format {args.format} writes a {suffix} file; "
                              f"expected a file name ending in {suffix}")
     model = load_model(args.model)
-    doc = state_space_export(model)
+    try:
+        doc = state_space_export(model)
+    except ParameterError as error:  # a model that has no state-space form: say which file
+        raise ParameterError(f"{str(args.model)!r}: {error}") from None
     write_export(args.out, args.format, doc, f"hwpts {__version__}", str(args.model))
     n = doc["modes"][0]["A"].shape[0]
     dt = doc["sample_time_s"]
