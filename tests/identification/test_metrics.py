@@ -33,3 +33,41 @@ def test_parameter_error_matches_modes():
     T = np.array([[1.0, 0.0], [0.0, 2.0]])
     E = np.array([[0.0, 2.2], [1.0, 0.1]])
     assert parameter_error(T, E) == pytest.approx(0.1)
+
+
+def test_region_accuracy_leaves_out_samples_without_a_true_region():
+    """-1 is "no region" (the initial conditions of predict_regions and of the zoo's modes): it
+    wrapped to the last region and counted as a miss (0.5 for identical labels)."""
+    assert region_accuracy([-1, -1, 0, 1], [-1, -1, 0, 1]) == 1.0
+    assert region_accuracy([-1, -1, 0, 0, 1], [-1, -1, 1, 1, 0]) == 1.0
+    assert region_accuracy([0, 0, 1], [0, -1, 1]) == pytest.approx(2 / 3)  # no region where one exists: a miss
+    with pytest.raises(DataError, match="no sample has a true region"):
+        region_accuracy([-1, -1], [0, 1])
+    with pytest.raises(DataError, match="whole region numbers"):
+        region_accuracy([np.nan, 1], [0, 1])
+
+
+def test_scores_refuse_what_they_cannot_score_and_do_not_overflow():
+    assert fit_percent([0, 1e160, -1e160], [0, 1.1e160, -1e160]) == pytest.approx(fit_percent([0, 1, -1], [0, 1.1, -1]))
+    assert fit_percent(np.array([[1.0], [2.0], [3.0]]), [1.0, 2.0, 3.5]) == pytest.approx(64.645, abs=1e-3)
+    with pytest.raises(DataError, match="complex"):
+        fit_percent(np.array([1 + 5j, 2]), [1, 2])
+    with pytest.raises(DataError, match=r"one signal \(1-D\), got shape \(2, 2\)"):
+        fit_percent([[1, 2], [3, 4]], [1, 2, 3, 4])
+    with pytest.raises(DataError, match="must hold numbers"):
+        fit_percent(["a", "b"], [1, 2])
+    with pytest.raises(DataError, match="theta_true must be a finite"):
+        parameter_error([[1.0, np.nan]], [[1.0, 2.0]])
+    with pytest.raises(DataError, match="beyond"):
+        parameter_error([[1.0, 2.0]], [[1.0, 2.0]], [0, 3], [0, 0])
+
+
+def test_synthetic_systems_check_their_settings():
+    from hwpts.errors import ParameterError
+    from hwpts.identification.synthetic import make_system
+
+    for number, kwargs, match in [(6, {}, "number must be one of"), (1, {"n": -5}, "n must be an int >= 10"),
+                                  (1, {"sigma": float("nan")}, "sigma must be a number >= 0"),
+                                  (1, {"N": 3}, "unknown setting")]:
+        with pytest.raises(ParameterError, match=match):
+            make_system(number, **kwargs)

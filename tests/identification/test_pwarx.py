@@ -393,7 +393,7 @@ def test_complex_and_sparse_input_are_refused():
     with pytest.raises(DataError, match="sparse matrix"):
         PWARX(1, 1, 1, n_regions=1, segmentation="average").fit(scipy.sparse.csr_matrix(d.inputs), d.output)
     model = PWARX(1, 1, 1, n_regions=1, segmentation="average").fit(d.inputs, d.output)
-    with pytest.raises(DataError, match="X is complex"):
+    with pytest.raises(DataError, match="inputs is complex"):
         model.predict(d.inputs * (1 + 0j), d.output)
     with pytest.raises(DataError, match="must hold numbers"):
         model.predict(np.array([["a", "b"]] * 300), d.output)

@@ -30,6 +30,13 @@ def two_modes(n=600, seed=0):
     (dict(refinement_rounds=1.5), "refinement_rounds must be an int >= 0, got 1.5"),
     (dict(refinement_rounds=-1), "refinement_rounds must be an int >= 0"),
     (dict(random_state="a"), "random_state must be None, an int >= 0 or a numpy Generator or SeedSequence, got 'a'"),
+    # found by a review (2026-11-26): these raised a TypeError or a library's message from inside
+    (dict(segmentation="threshold", segmentation_params=[1, 2]), "segmentation_params must be a dict"),
+    (dict(segmentation="alternating", partition_columns=[]), "partition_columns must be a column name or a non-empty list"),
+    (dict(segmentation="alternating", partition_columns=5), "partition_columns must be"),
+    (dict(segmentation="hyperplane", hyperplanes=5), "hyperplanes must be a list of hyperplanes"),
+    (dict(segmentation="threshold", region_models=5), "region_models must be a list"),
+    (dict(segmentation="threshold", region_models="affine"), "region_models must be a list"),
 ])
 def test_estimator_settings_are_checked(setting, match):
     u, y = two_modes()
@@ -87,6 +94,68 @@ def test_search_settings_are_checked(setting, match):
     u, y = two_modes()
     with pytest.raises(ParameterError, match=match):
         PWARXSearch(PWARX(1, 1, 1, random_state=0), **setting).fit(u, y)
+
+
+@pytest.mark.parametrize("fit_args, match", [
+    (dict(sample_time="0.1"), "sample_time must be a positive number of seconds"),
+    (dict(units=5), "units must be a dict"),
+    (dict(output_name=5), "output_name must be a non-empty string"),
+])
+def test_fit_arguments_are_checked_before_the_model_changes(fit_args, match):
+    u, y = two_modes()
+    model = PWARX(1, 1, 1, segmentation="threshold", random_state=0).fit(u, y, units={"y": "mm"})
+    before = model.theta_.copy()
+    with pytest.raises(ParameterError, match=match):
+        model.fit(np.column_stack([u, u ** 2]), y, **fit_args)
+    assert model.n_features_in_ == 1 and np.array_equal(model.theta_, before) and model.units_ == {"y": "mm"}
+    with pytest.raises(ParameterError, match=match):
+        PWARXSearch(PWARX(1, 1, 1, random_state=0)).fit(u, y, **fit_args)
+
+
+def test_the_search_says_what_the_estimator_says_not_that_every_candidate_failed():
+    """A bad estimator setting, a constant output or a grid naming no setting of the estimator
+    was reported as 'every candidate model diverged in free run or failed' (a RuntimeError)."""
+    u, y = two_modes()
+    with pytest.raises(ParameterError, match="^ridge must be a number >= 0, got -1"):
+        PWARXSearch(PWARX(1, 1, 1, ridge=-1)).fit(u, y)
+    with pytest.raises(DataError, match="the output is constant"):
+        PWARXSearch(PWARX(1, 1, 1)).fit(u, np.ones(y.size))
+    with pytest.raises(ParameterError, match=r"param_grid names \['foo'\], which the estimator does not have"):
+        PWARXSearch(PWARX(1, 1, 1), param_grid={"foo": [1]}).fit(u, y)
+
+
+def test_inputs_are_checked_without_an_output_and_a_short_record_is_all_initial_conditions():
+    u, y = two_modes()
+    model = PWARX(3, 2, 1, segmentation="threshold", random_state=0).fit(u, y)
+    bad = u.copy()
+    bad[50, 0] = np.nan
+    with pytest.raises(DataError, match="inputs has a non-finite value .* at row 50"):
+        model.simulate(bad, initial_output=y[:3])  # was a run 'diverged' at sample 50
+    bad[50, 0] = 1e300
+    with pytest.raises(DataError, match="inputs has the value 1e\\+300 at row 50"):
+        model.simulate(bad, initial_output=y[:3])
+    static = PWARX(0, 1, 0, segmentation="threshold", random_state=0).fit(u, np.abs(u[:, 0]))
+    bad[50, 0] = np.nan
+    with pytest.raises(DataError, match="non-finite"):
+        static.predict(bad)  # was nan at row 50
+    for n in (1, 2, 3):  # n < max_lag with the measured output: the initial conditions only (n = 2 raised
+        np.testing.assert_array_equal(model.simulate(u[:n], y[:n]).output, y[:n])  # a broadcast error)
+
+
+def test_pandas_records_read_by_position_are_refused_where_position_is_wrong():
+    pd = pytest.importorskip("pandas")
+    u, y = two_modes()
+    index = pd.date_range("2026-01-01", periods=y.size, freq="s")
+    X, Y = pd.DataFrame({"u": u[:, 0]}, index=index), pd.Series(y, index=index, name="y")
+    model = PWARX(1, 1, 1, segmentation="threshold", random_state=0).fit(X, Y)
+    with pytest.raises(DataError, match="X and y have different indexes"):
+        PWARX(1, 1, 1).fit(X, Y.iloc[::-1])
+    with pytest.raises(DataError, match="X and y have different indexes"):
+        model.predict(X, Y.sample(frac=1.0, random_state=0))
+    with pytest.raises(DataError, match="time index is not increasing"):
+        PWARX(1, 1, 1).fit(X.iloc[::-1], Y.iloc[::-1])
+    with pytest.raises(DataError, match="holds dates or durations"):
+        PWARX(1, 1, 1).fit(pd.DataFrame({"u": index}), y)
 
 
 def test_one_method_name_is_one_method():

@@ -17,9 +17,24 @@ from hwpts.errors import DataError
 __all__ = ["fit_percent", "rmse", "region_accuracy", "best_permutation", "parameter_error"]
 
 
+def _signal(values, label: str) -> np.ndarray:
+    """One signal as a 1-D float array: a column or row vector is one; a matrix, complex or
+    non-numeric values are refused (a cast would flatten, drop the imaginary part or fail)."""
+    arr = np.asarray(values)
+    if np.iscomplexobj(arr):
+        raise DataError(f"{label} is complex; a fit is scored on real signals")
+    try:
+        arr = arr.astype(float)
+    except (TypeError, ValueError):
+        raise DataError(f"{label} must hold numbers, got values of type {arr.dtype}") from None
+    if arr.ndim > 1 and sum(d > 1 for d in arr.shape) > 1:
+        raise DataError(f"{label} must be one signal (1-D), got shape {arr.shape}")
+    return arr.ravel()
+
+
 def _pair(y, yhat):
-    y = np.asarray(y, dtype=float).ravel()
-    yhat = np.asarray(yhat, dtype=float).ravel()
+    y = _signal(y, "the measured output")
+    yhat = _signal(yhat, "the prediction")
     if y.shape != yhat.shape:
         raise DataError(f"measured and predicted outputs differ in length: {y.size} vs {yhat.size}")
     if y.size == 0:
@@ -41,6 +56,9 @@ def fit_percent(y, yhat) -> float:
     y, yhat = _pair(y, yhat)
     if not np.all(np.isfinite(yhat)):
         return float("nan")
+    scale = max(float(np.max(np.abs(y))), float(np.max(np.abs(yhat))))
+    if scale > 1e150:  # the norms' squares would overflow (a 1e160 signal scored nan): scale both first
+        y, yhat = y / scale, yhat / scale
     den = np.linalg.norm(y - y.mean())
     if den == 0:
         if np.ptp(y) > 0:  # it varies, by less than the squares can hold (1e-200)
@@ -58,12 +76,34 @@ def rmse(y, yhat) -> float:
     return float(np.sqrt(np.mean((y - yhat) ** 2)))
 
 
+def _labels(values, label: str) -> np.ndarray:
+    """Region labels as a 1-D int array: whole numbers, ``-1`` (or any negative) for "no region"
+    (the initial conditions of :meth:`PWARX.predict_regions` and of the zoo's ``modes``)."""
+    arr = np.asarray(values)
+    if arr.dtype.kind not in "biu":
+        try:
+            as_float = arr.astype(float)
+        except (TypeError, ValueError):
+            raise DataError(f"{label} must be region numbers, got values of type {arr.dtype}") from None
+        if not np.all(np.isfinite(as_float)) or np.any(as_float != np.round(as_float)):
+            raise DataError(f"{label} must be whole region numbers (-1 for none), got a non-integer or NaN value")
+        arr = as_float
+    return np.asarray(arr, dtype=np.int64).ravel()
+
+
 def best_permutation(true_labels, est_labels, n_true: int | None = None, n_est: int | None = None) -> dict:
-    """Matching estimated region -> true region maximising agreement (``linear_sum_assignment``)."""
-    t = np.asarray(true_labels, dtype=np.int64).ravel()
-    e = np.asarray(est_labels, dtype=np.int64).ravel()
-    n_t = n_true or int(t.max()) + 1
-    n_e = n_est or int(e.max()) + 1
+    """Matching estimated region -> true region maximising agreement (``linear_sum_assignment``);
+    samples without a region (a negative label) on either side are left out of the count."""
+    t = _labels(true_labels, "true_labels")
+    e = _labels(est_labels, "est_labels")
+    if t.shape != e.shape:
+        raise DataError(f"label arrays must be equal in length: {t.size} vs {e.size}")
+    both = (t >= 0) & (e >= 0)
+    t, e = t[both], e[both]
+    n_t = n_true or (int(t.max()) + 1 if t.size else 1)
+    n_e = n_est or (int(e.max()) + 1 if e.size else 1)
+    if t.size and (t.max() >= n_t or e.max() >= n_e):
+        raise DataError(f"a label is beyond the {n_t} true or {n_e} estimated regions")
     counts = np.zeros((n_e, n_t))
     np.add.at(counts, (e, t), 1)
     rows, cols = linear_sum_assignment(counts, maximize=True)
@@ -71,13 +111,25 @@ def best_permutation(true_labels, est_labels, n_true: int | None = None, n_est: 
 
 
 def region_accuracy(true_labels, est_labels) -> float:
-    """Share (0..1) of samples whose estimated region matches the true one, best permutation."""
-    t = np.asarray(true_labels, dtype=np.int64).ravel()
-    e = np.asarray(est_labels, dtype=np.int64).ravel()
+    """Share (0..1) of samples whose estimated region matches the true one, best permutation.
+
+    Samples whose true label is negative (no mode: the initial conditions) are left out; an
+    estimated negative label where a true region exists counts as a miss.
+
+    >>> region_accuracy([-1, -1, 0, 0, 1], [-1, -1, 1, 1, 0])
+    1.0
+    """
+    t = _labels(true_labels, "true_labels")
+    e = _labels(est_labels, "est_labels")
     if t.shape != e.shape or t.size == 0:
         raise DataError(f"label arrays must be non-empty and equal in length: {t.size} vs {e.size}")
+    keep = t >= 0
+    if not keep.any():
+        raise DataError("no sample has a true region (every true label is negative)")
+    t, e = t[keep], e[keep]
     perm = best_permutation(t, e)
-    mapped = np.array([perm.get(int(v), -1) for v in range(int(e.max()) + 1)])[e]
+    table = np.array([perm.get(v, -1) for v in range(max(int(e.max()), 0) + 1)])
+    mapped = np.where(e >= 0, table[np.maximum(e, 0)], -1)
     return float(np.mean(mapped == t))
 
 
@@ -89,6 +141,10 @@ def parameter_error(theta_true, theta_est, true_labels=None, est_labels=None) ->
     """
     T = np.atleast_2d(np.asarray(theta_true, dtype=float))
     E = np.atleast_2d(np.asarray(theta_est, dtype=float))
+    for label, arr in (("theta_true", T), ("theta_est", E)):
+        if arr.ndim != 2 or arr.size == 0 or not np.all(np.isfinite(arr)):
+            raise DataError(f"{label} must be a finite (modes, parameters) array, got shape {arr.shape}"
+                            f"{'' if arr.size == 0 or np.all(np.isfinite(arr)) else ' with NaN or inf'}")
     if T.shape[1] != E.shape[1]:
         raise DataError(f"parameter vectors differ in length: {T.shape[1]} vs {E.shape[1]}")
     if true_labels is not None and est_labels is not None:

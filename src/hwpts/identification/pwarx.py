@@ -18,6 +18,7 @@ is the free run with the switching rule, ``score`` is the free-run fit %.
 from __future__ import annotations
 
 import warnings
+from collections.abc import Mapping
 
 import numpy as np
 from sklearn.base import BaseEstimator
@@ -38,6 +39,7 @@ from hwpts.identification.regressors import (
     default_input_names,
     dense_real,
     power_scaling,
+    validate_inputs,
     validate_signals,
 )
 from hwpts.identification.segmentation import make_segmenter
@@ -200,6 +202,7 @@ class PWARX(BaseEstimator):
             return X.inputs, X.output, X.input_names, X.output_name
         if y is None:
             raise ParameterError("fit needs the measured output y (or an IODataset)")
+        _check_index(X, y)
         frame_names = _column_names(X)
         if frame_names is not None and getattr(X, "columns", None) is None and names is not None:
             frame_names = None  # a named Series: the names given win over its name
@@ -227,6 +230,18 @@ class PWARX(BaseEstimator):
         check_number(self.ridge, "ridge")
         check_number(self.classifier_C, "classifier_C", strict=True)
         check_count(self.refinement_rounds, "refinement_rounds", 0)
+        if self.segmentation_params is not None and not isinstance(self.segmentation_params, Mapping):
+            raise ParameterError(f"segmentation_params must be a dict of the method's settings or None, "
+                                 f"got {self.segmentation_params!r}")
+        for name in ("hyperplanes", "region_models", "partition_columns"):
+            value = getattr(self, name)
+            if value is None or (name == "partition_columns" and isinstance(value, str)):
+                continue  # one column name is one column
+            if isinstance(value, (str, bytes, Mapping)) or not hasattr(value, "__len__") or not len(value):
+                what = {"hyperplanes": "a list of hyperplanes ('a,b,c' texts or Hyperplane objects)",
+                        "region_models": "a list of region model kinds (one per region)",
+                        "partition_columns": "a column name or a non-empty list of them"}[name]
+                raise ParameterError(f"{name} must be {what} or None, got {value!r}")
         seed = self.random_state
         try:  # what numpy's default_rng takes: None, an int >= 0, a SeedSequence, a Generator, ...
             if isinstance(seed, (bool, np.bool_, str, bytes, float)):
@@ -274,9 +289,7 @@ class PWARX(BaseEstimator):
             uniform = X.uniform_sample_time("the dataset's time", LIBRARY_REMEDY)
             if sample_time is None:
                 sample_time = uniform
-        if sample_time is not None and (isinstance(sample_time, bool) or not np.isfinite(sample_time)
-                                        or sample_time <= 0):
-            raise ParameterError(f"sample_time must be a positive number of seconds or None, got {sample_time!r}")
+        check_fit_arguments(sample_time, units, output_name)
         self._check_settings()
         u, yy, names, oname = self._signals(X, y, input_names, output_name)
         n_inputs = u.shape[1]
@@ -416,6 +429,7 @@ class PWARX(BaseEstimator):
                                 f"its lags would mean other delays; resample the data or refit")
             X, y = _select_columns(X.inputs, X.input_names, self.input_names_), X.output
         else:
+            _check_index(X, y)
             frame_names = _column_names(X)
             X = _as_array(X)
             if frame_names is not None:
@@ -425,15 +439,10 @@ class PWARX(BaseEstimator):
                 f"the measured output is needed (the first {self.structure_.max_lag} samples are "
                 f"the initial conditions)"
             )
-        u = dense_real(X, "X")
-        if u.ndim == 1:
-            u = u[:, None]
         yy = None if y is None else _output_vector(y)
         if yy is not None:
-            u, yy = validate_signals(u, yy, self.n_features_in_)
-        elif u.shape[1] != self.n_features_in_:
-            raise DataError(f"expected {self.n_features_in_} input columns, got {u.shape[1]}")
-        return u, yy
+            return validate_signals(X, yy, self.n_features_in_)
+        return validate_inputs(X, self.n_features_in_), None
 
     def _prediction_inputs(self, X, y):
         """Inputs and outputs for a prediction: the measured output only where the regressor has
@@ -607,6 +616,19 @@ LIBRARY_REMEDY = ("resample it, or fit the arrays with breaks at the gaps: "
                   "fit(data.inputs, data.output, breaks=[...])")
 
 
+def check_fit_arguments(sample_time, units, output_name) -> None:
+    """The arguments of ``fit`` beside the data (PWARX's and PWARXSearch's), checked before any
+    state changes: a bad one raised a TypeError from numpy, or after the fit had replaced the model."""
+    from hwpts.identification.settings import is_number
+
+    if sample_time is not None and not is_number(sample_time, strict=True):
+        raise ParameterError(f"sample_time must be a positive number of seconds or None, got {sample_time!r}")
+    if units is not None and not isinstance(units, Mapping):
+        raise ParameterError(f"units must be a dict {{signal name: unit}} or None, got {units!r}")
+    if output_name is not None and (not isinstance(output_name, str) or not output_name):
+        raise ParameterError(f"output_name must be a non-empty string, got {output_name!r}")
+
+
 def _check_names(names, output_name, n_inputs):
     """The inputs' names: one per input column, distinct, none the output's (a regressor column is
     chosen by name: ``partition_columns``, ``--partition-column``, the model file)."""
@@ -648,6 +670,20 @@ def _column_names(X) -> tuple[str, ...] | None:
             return (name,)
         return None
     return tuple(str(c) for c in columns)
+
+
+def _check_index(X, y) -> None:
+    """pandas inputs are read by position, as scikit-learn reads them: refuse what position would
+    read wrong without a word, an output indexed otherwise than the inputs and a time index
+    that is not increasing (unsorted records: every lag would be another sample)."""
+    x_index, y_index = getattr(X, "index", None), getattr(y, "index", None)
+    if x_index is not None and y_index is not None and hasattr(x_index, "equals") and not x_index.equals(y_index):
+        raise DataError("X and y have different indexes and are read by position: align them first "
+                        "(y.reindex(X.index)) or pass arrays")
+    for label, index in (("X", x_index), ("y", y_index)):
+        if index is not None and getattr(index, "dtype", None) is not None and index.dtype.kind in "mM" \
+                and not index.is_monotonic_increasing:
+            raise DataError(f"{label}'s time index is not increasing: sort the records by time ({label}.sort_index())")
 
 
 def _as_array(X):

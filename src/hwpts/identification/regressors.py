@@ -321,6 +321,9 @@ def dense_real(values, label: str) -> np.ndarray:
     arr = np.asarray(values)
     if np.iscomplexobj(arr):
         raise DataError(f"{label} is complex; hwpts models real signals (pass the real part or the magnitude)")
+    if arr.dtype.kind in "mM":  # numpy casts dates to nanosecond counts without a word
+        raise DataError(f"{label} holds dates or durations ({arr.dtype}); hwpts models numeric signals (pass the "
+                        f"time as the dataset's time axis, not as a signal)")
     if arr.dtype.kind not in "biuf":
         try:
             arr = arr.astype(float)
@@ -329,31 +332,42 @@ def dense_real(values, label: str) -> np.ndarray:
     return np.asarray(arr, dtype=float)
 
 
-def validate_signals(inputs, output, n_inputs: int | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Inputs as (n, p) float array and output as (n,) float array, finite, same length."""
+def validate_inputs(inputs, n_inputs: int | None = None) -> np.ndarray:
+    """Inputs as a finite (n, p) float array (a 1-D array is one input)."""
     u = dense_real(inputs, "inputs")
     if u.ndim == 1:
         u = u[:, None]
-    y = dense_real(output, "output")
     if u.ndim != 2:
         raise DataError(f"inputs must be 2-D (n_samples, n_inputs); got shape {u.shape}")
+    if n_inputs is not None and u.shape[1] != n_inputs:
+        raise DataError(f"expected {n_inputs} input columns, got {u.shape[1]}")
+    _check_values("inputs", u)
+    return u
+
+
+def validate_signals(inputs, output, n_inputs: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Inputs as (n, p) float array and output as (n,) float array, finite, same length."""
+    u = validate_inputs(inputs, n_inputs)
+    y = dense_real(output, "output")
     if y.ndim != 1:
         raise DataError(f"output must be 1-D; got shape {y.shape}")
     if u.shape[0] != y.shape[0]:
         raise DataError(f"inputs have {u.shape[0]} rows but output has {y.shape[0]}")
-    if n_inputs is not None and u.shape[1] != n_inputs:
-        raise DataError(f"expected {n_inputs} input columns, got {u.shape[1]}")
-    for label, arr in (("inputs", u), ("output", y)):
-        bad = ~np.isfinite(arr)
-        if bad.any():
-            row = int(np.argwhere(bad.reshape(arr.shape[0], -1))[0, 0])
-            raise DataError(f"{label} has a non-finite value (NaN or inf) at row {row}")
-        huge = np.abs(arr) > MAX_ABS_VALUE
-        if huge.any():
-            row = int(np.argwhere(huge.reshape(arr.shape[0], -1))[0, 0])
-            raise DataError(f"{label} has the value {arr.reshape(arr.shape[0], -1)[row].max():.3g} at row {row}, beyond "
-                            f"+-{MAX_ABS_VALUE:.0e}: its squares overflow the least squares; rescale the signal")
+    _check_values("output", y)
     return u, y
+
+
+def _check_values(label: str, arr: np.ndarray) -> None:
+    """Every value finite and within +-MAX_ABS_VALUE (else a DataError naming the first row)."""
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        row = int(np.argwhere(bad.reshape(arr.shape[0], -1))[0, 0])
+        raise DataError(f"{label} has a non-finite value (NaN or inf) at row {row}")
+    huge = np.abs(arr) > MAX_ABS_VALUE
+    if huge.any():
+        row = int(np.argwhere(huge.reshape(arr.shape[0], -1))[0, 0])
+        raise DataError(f"{label} has the value {np.abs(arr.reshape(arr.shape[0], -1)[row]).max():.3g} at row {row}, "
+                        f"beyond +-{MAX_ABS_VALUE:.0e}: its squares overflow the least squares; rescale the signal")
 
 
 def names_or_default(names: Sequence[str] | None, n: int, prefix: str) -> tuple[str, ...]:

@@ -169,8 +169,8 @@ def simulate_pwarx(structure, partition, theta, inputs, initial_output, center=0
     n = u.shape[0]
     m = structure.max_lag
     y0 = np.zeros(m)
-    init = np.asarray(initial_output, dtype=float).ravel()
-    y0[:] = init[:m]
+    init = np.asarray(initial_output, dtype=float).ravel()[:m]
+    y0[:init.size] = init  # a record shorter than max_lag is all initial conditions (the kernel reads n of them)
     sig, lag = structure.lags
     H, g, row_start = partition.flat()
     yhat, regions, k = _simulate_kernel(

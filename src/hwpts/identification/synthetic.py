@@ -12,6 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hwpts.errors import ParameterError
+
 __all__ = ["SyntheticData", "SYSTEMS", "make_system", "simulate_true_pwarx"]
 
 
@@ -156,5 +158,17 @@ SYSTEMS = {1: system1, 2: system2, 3: system3, 4: system4, 5: system5}
 
 
 def make_system(number: int, rng=None, **kwargs) -> SyntheticData:
-    """Data of synthetic system ``number`` (1-5) of this module."""
+    """Data of synthetic system ``number`` (1-5) of this module; ``n`` (samples, at least 10) and
+    ``sigma`` (noise standard deviation, >= 0) override the system's own."""
+    from hwpts.identification.settings import check_count, check_number
+
+    if isinstance(number, bool) or number not in SYSTEMS:
+        raise ParameterError(f"make_system: number must be one of {sorted(SYSTEMS)}, got {number!r}")
+    unknown = set(kwargs) - {"n", "sigma"}
+    if unknown:
+        raise ParameterError(f"make_system: unknown setting(s) {sorted(unknown)}; valid are n and sigma")
+    if "n" in kwargs:
+        check_count(kwargs["n"], "n", 10, owner="make_system: ")
+    if "sigma" in kwargs:
+        check_number(kwargs["sigma"], "sigma", 0.0, owner="make_system: ")
     return SYSTEMS[number](rng=rng, **kwargs)

@@ -14,10 +14,11 @@ import hashlib
 import json
 import math
 import os
+import warnings
 
 import numpy as np
 
-from hwpts.errors import DataError, HwptsError
+from hwpts.errors import DataError, HwptsError, ParameterError
 
 SCHEMA = "hwpts.pwarx/1"
 CHECKED_SECTIONS = ("structure", "regions", "partition", "training", "signals")
@@ -71,6 +72,13 @@ def _settings(model) -> dict:
             params["segmentation_params"] = segmenter.get_params(deep=False) or None
     if params.get("hyperplanes") is not None:
         params["hyperplanes"] = [_hyperplane_text(h) for h in params["hyperplanes"]]
+    seed = params.get("random_state")
+    if isinstance(seed, np.random.SeedSequence) and not seed.spawn_key and isinstance(seed.entropy, int) \
+            and seed.pool_size == np.random.SeedSequence().pool_size:
+        params["random_state"] = seed.entropy  # default_rng(SeedSequence(s)) draws what default_rng(s) does
+    elif seed is not None and not isinstance(seed, (int, np.integer)):
+        warnings.warn(f"random_state ({type(seed).__name__}) is not written to the model file: the loaded model "
+                      f"refits with random_state=None; fit with an int seed to keep it", UserWarning, stacklevel=5)
     out = {}
     for key in SETTINGS:
         value = _jsonable(params.get(key))
@@ -92,6 +100,12 @@ def checksum(doc: dict, sections=CHECKED_SECTIONS) -> str:
 def model_to_dict(model) -> dict:
     """The JSON document of a fitted :class:`~hwpts.identification.PWARX`."""
     from hwpts import __version__
+
+    if not hasattr(model, "structure_"):
+        if hasattr(model, "best_estimator_"):
+            raise ParameterError("a model file holds one model: save the search's best_estimator_")
+        raise ParameterError(f"only a fitted PWARX model can be saved, got {type(model).__name__} "
+                             f"{'(not fitted)' if hasattr(model, 'fit') else ''}".rstrip())
 
     st = model.structure_
     regions = []

@@ -248,6 +248,10 @@ class Hyperplane:
             raise ParameterError("a hyperplane needs at least one coefficient")
         if not all(np.isfinite(self.coefficients)) or not np.isfinite(self.offset):
             raise ParameterError(f"hyperplane coefficients must be finite, got {self}")
+        for c in self.columns or ():
+            if "," in c or "@" in c or c != c.strip():  # the model file writes "a,b,c@col1,col2"
+                raise ParameterError(f"a hyperplane's column name cannot hold ',' or '@' or surrounding spaces "
+                                     f"(written as 'a,b,c@col1,col2'), got {c!r}; rename the column")
         if self.columns is not None and len(self.columns) != len(self.coefficients):
             raise ParameterError(
                 f"hyperplane {self}: {len(self.coefficients)} coefficients for {len(self.columns)} columns"

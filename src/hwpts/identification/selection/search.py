@@ -547,14 +547,17 @@ class PWARXSearch(BaseEstimator):
             uniform = X.uniform_sample_time("the dataset's time", LIBRARY_REMEDY)
             if sample_time is None:
                 sample_time = uniform
-        if sample_time is not None and (isinstance(sample_time, bool) or not np.isfinite(sample_time)
-                                        or sample_time <= 0):
-            raise ParameterError(f"sample_time must be a positive number of seconds or None, got {sample_time!r}")
+        from hwpts.identification.pwarx import check_fit_arguments
+
+        check_fit_arguments(sample_time, units, output_name)
+        self._check_params()
         base = self._base()
+        base._check_settings()  # a bad estimator setting is said as PWARX says it, not as every candidate failing
         u, yy, names, oname = base._signals(X, y, input_names, output_name)
+        if np.ptp(yy) == 0:
+            raise DataError(f"the output is constant in the training data ({yy[0]:.6g}); there is nothing to identify")
         self._names = (names, oname)
         n = yy.shape[0]
-        self._check_params()
         # "auto" is decided after the ARX stage of the adaptive search; until then the free run ranks
         self.scoring_ = "one_step" if self.scoring == "one_step" else "free_run"
         self._powers = self._powers_to_try()
@@ -585,6 +588,11 @@ class PWARXSearch(BaseEstimator):
                     candidates = expand_grid(self.param_grid)
                     if not candidates:
                         raise ParameterError("PWARXSearch: param_grid leaves nothing to try")
+                    valid = base.get_params(deep=True)
+                    unknown = sorted({k for c in candidates for k in c} - set(valid))
+                    if unknown:
+                        raise ParameterError(f"PWARXSearch: param_grid names {unknown}, which the estimator does not "
+                                             f"have; valid are {sorted(valid)}")
                     table = self._run(base, candidates, u, yy, splits, "grid", bar)
                 else:
                     table = self._adaptive(base, order_grid, u, yy, splits, bar)
