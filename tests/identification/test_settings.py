@@ -118,7 +118,7 @@ def test_the_search_says_what_the_estimator_says_not_that_every_candidate_failed
     u, y = two_modes()
     with pytest.raises(ParameterError, match="^ridge must be a number >= 0, got -1"):
         PWARXSearch(PWARX(1, 1, 1, ridge=-1)).fit(u, y)
-    with pytest.raises(DataError, match="the output is constant"):
+    with pytest.raises(DataError, match="output 'y' is constant"):
         PWARXSearch(PWARX(1, 1, 1)).fit(u, np.ones(y.size))
     with pytest.raises(ParameterError, match=r"param_grid names \['foo'\], which the estimator does not have"):
         PWARXSearch(PWARX(1, 1, 1), param_grid={"foo": [1]}).fit(u, y)

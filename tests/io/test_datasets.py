@@ -72,14 +72,25 @@ def test_bad_paths(tmp_path):
         read_table(tmp_path / "x.mat")
 
 
-def test_nan_is_read_then_refused_by_the_dataset(tmp_path):
-    from hwpts.dataset import IODataset
-
+def test_a_missing_value_is_refused_with_its_line(tmp_path):
+    """A missing cell (empty, "nan", "NA") is named by its line in the file, blank lines counted; a
+    row of empty fields is a row of missing values (the line-by-line reader dropped it, shifting
+    every later sample); a hexadecimal cell, which pyarrow reads as a number, is no number."""
     path = tmp_path / "n.csv"
     path.write_text("u,y\n1,2\nnan,3\n")
-    cols = read_table(path)
-    with pytest.raises(DataError, match="non-finite"):
-        IODataset.from_columns(cols, ["u"], "y", time_name=None)
+    with pytest.raises(DataError, match="line 3, column 'u': expected a finite number, got 'nan'"):
+        read_table(path)
+    path.write_text("u,y\n1,2\n\n\n2,NA\n")
+    with pytest.raises(DataError, match="line 5, column 'y': expected a number, got 'NA'"):
+        read_table(path)
+    path.write_text("u,y,\n1,2,\n,\n2,3,\n")  # the trailing commas send it to the line-by-line reader
+    with pytest.raises(DataError, match="line 3, column 'u': expected a number, got an empty cell"):
+        read_table(path)
+    path.write_text("u,y\n1,2\n0x10,3\n")
+    with pytest.raises(DataError, match="line 3, column 'u': expected a number, got '0x10'"):
+        read_table(path)
+    path.write_text("u,y\n1,2\n \n2,3\n\n")  # blank lines are no rows
+    np.testing.assert_array_equal(read_table(path)["u"], [1.0, 2.0])
 
 
 @pytest.mark.parametrize("text", [

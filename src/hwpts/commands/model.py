@@ -102,7 +102,7 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
                 read_table(path, [*signals, name])
                 readable.append(name)
             except DataError:
-                if numeric_share(path, name) >= 0.9:  # ... but one of numbers with a mistyped cell is broken
+                if numeric_share(path, name) > 0.5:  # ... but one of numbers with mistyped cells is broken
                     raise
         columns = read_table(path, [*signals, *readable])  # (a bad signal column raises its own error here)
     if time_name not in (None, NO_TIME) and time_name not in columns:

@@ -103,10 +103,23 @@ def read_csv(path: str | os.PathLike, columns=None) -> dict[str, np.ndarray]:
         column = table.column(i)
         if not (pa.types.is_floating(column.type) or pa.types.is_integer(column.type) or pa.types.is_null(column.type)):
             return _read_csv_python(p, delimiter, columns)
+        if column.null_count:  # an empty or "NA" cell: the line-by-line reader names its line
+            return _read_csv_python(p, delimiter, columns)
+        if pa.types.is_integer(column.type) and _has_hex(p):  # pyarrow reads "0x10" as 16; no CSV writer means that
+            return _read_csv_python(p, delimiter, columns)
         # unsafe: an integer beyond 2^53 (a nanosecond epoch time) rounds to the nearest float
         # instead of raising pyarrow's range error
         out[name] = column.cast(pa.float64(), safe=False).to_numpy(zero_copy_only=False)
     return out
+
+
+def _has_hex(p: Path) -> bool:
+    """Whether the file holds a hexadecimal literal's prefix anywhere (``0x``)."""
+    try:
+        data = p.read_bytes()
+    except OSError:
+        return False
+    return b"0x" in data or b"0X" in data
 
 
 def numeric_share(path: str | os.PathLike, column: str) -> float:
@@ -146,8 +159,15 @@ def _read_csv_python(p: Path, delimiter: str = ",", columns=None) -> dict[str, n
         raise DataError(f"{str(p)!r}: not a UTF-8 text file, expected CSV") from None
     except OSError as error:
         raise DataError(f"{str(p)!r}: cannot read ({error.strerror or error})") from None
-    rows = list(csv.reader(io.StringIO(text), delimiter=delimiter))
-    rows = [r for r in rows if any(cell.strip() for cell in r)]
+    # (line number, row); a blank line is skipped, as the fast reader skips it, but a row of empty
+    # fields (",,") is a row of missing values: dropped, it shifted every later sample in silence
+    reader = csv.reader(io.StringIO(text), delimiter=delimiter)
+    numbered, line = [], 1
+    for row in reader:
+        if len(row) > 1 or (row and row[0].strip()):
+            numbered.append((line, row))
+        line = reader.line_num + 1
+    rows = [r for _, r in numbered]
     if not rows:
         raise DataError(f"{str(p)!r}: empty file, expected a header row of column names")
     header = [h.strip() for h in rows[0]]
@@ -166,7 +186,7 @@ def _read_csv_python(p: Path, delimiter: str = ",", columns=None) -> dict[str, n
         raise DataError(f"{str(p)!r}: no data rows after the header")
     wanted = [j for j, h in enumerate(header) if columns is None or h in set(columns)]
     values = np.empty((len(body), len(header)))
-    for i, row in enumerate(body, start=2):
+    for k, (i, row) in enumerate(numbered[1:]):
         while len(row) > len(header) and not row[-1].strip():
             row = row[:-1]
         if len(row) != len(header):
@@ -176,11 +196,13 @@ def _read_csv_python(p: Path, delimiter: str = ",", columns=None) -> dict[str, n
         for j in wanted:
             cell = row[j]
             try:
-                values[i - 2, j] = plain_float(cell)
+                values[k, j] = value = plain_float(cell)
             except ValueError:
-                raise DataError(
-                    f"{str(p)!r} line {i}, column {header[j]!r}: expected a number, got {cell.strip()!r}"
-                ) from None
+                got = "an empty cell (a missing value)" if not cell.strip() else repr(cell.strip())
+                raise DataError(f"{str(p)!r} line {i}, column {header[j]!r}: expected a number, got {got}") from None
+            if not np.isfinite(value):
+                raise DataError(f"{str(p)!r} line {i}, column {header[j]!r}: expected a finite number, got "
+                                f"{cell.strip()!r} (a missing value)")
     return {header[j]: values[:, j].copy() for j in wanted}
 
 

@@ -555,7 +555,8 @@ class PWARXSearch(BaseEstimator):
         base._check_settings()  # a bad estimator setting is said as PWARX says it, not as every candidate failing
         u, yy, names, oname = base._signals(X, y, input_names, output_name)
         if np.ptp(yy) == 0:
-            raise DataError(f"the output is constant in the training data ({yy[0]:.6g}); there is nothing to identify")
+            raise DataError(f"output {oname or 'y'!r} is constant in the training data ({yy[0]:.6g}); "
+                            f"there is nothing to identify")
         self._names = (names, oname)
         n = yy.shape[0]
         # "auto" is decided after the ARX stage of the adaptive search; until then the free run ranks
