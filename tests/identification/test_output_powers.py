@@ -288,3 +288,13 @@ def test_the_powers_must_beat_the_affine_pieces(monkeypatch, powered, chosen):
                          refit_margin=1000.0).fit(u, y)
     assert search.best_params_.get("output_powers", ()) == chosen
     assert search.best_params_["n_regions"] == (1 if chosen else 2)
+
+
+def test_a_one_step_prediction_that_overflows_is_an_error_not_inf():
+    """Data 1e60 times the training range: the cubic term's prediction passed 1e168 (squares
+    overflow) and `hwpts residuals` called the inf residuals white with exit 0."""
+    u, y = duffing(800, 0)
+    model = PWARX(1, 1, 1, n_regions=1, segmentation="average", output_powers=(2, 3)).fit(u, y)
+    with pytest.raises(DataError, match="one-step prediction overflows .* holds powers"):
+        model.predict(u, y * 1e60)
+    assert np.all(np.isfinite(model.predict(u, y)))

@@ -39,6 +39,7 @@ from hwpts.identification.regressors import (
     default_input_names,
     dense_real,
     power_scaling,
+    MAX_ABS_VALUE,
     validate_inputs,
     validate_signals,
 )
@@ -471,6 +472,14 @@ class PWARX(BaseEstimator):
             raise ParameterError(f"horizon must be an int >= 1 (samples), got {horizon!r}")
         if horizon == 1:
             yhat, _ = one_step_pwarx(self.structure_, self.partition_, self.theta_, u, yy)
+            with np.errstate(invalid="ignore"):
+                bad = ~(np.abs(yhat) <= MAX_ABS_VALUE)  # inf, nan, or squares that would overflow
+            if bad.any():
+                lo, hi = self.output_range_
+                raise DataError(f"the one-step prediction overflows (beyond +-{MAX_ABS_VALUE:.0e}) at sample "
+                                f"{int(np.argmax(bad))}: the data lie far "
+                                f"beyond the range the model was identified on (output {lo:.4g} to {hi:.4g}"
+                                f"{', and its regressor holds powers of it' if self.structure_.output_powers else ''})")
             return yhat
         center, half = self.divergence_band()
         yhat, _ = k_step_pwarx(self.structure_, self.partition_, self.theta_, u, yy, int(horizon), center, half)

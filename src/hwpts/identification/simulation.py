@@ -188,11 +188,14 @@ def simulate_pwarx(structure, partition, theta, inputs, initial_output, center=0
 
 
 def one_step_pwarx(structure, partition, theta, inputs, output) -> tuple[np.ndarray, np.ndarray]:
-    """One-step-ahead prediction from measured outputs: (yhat, regions), first max_lag measured/-1."""
-    X, _ = structure.build(inputs, output, fit=False)
-    regions = partition.predict(X)
-    th = np.asarray(theta)[regions]
-    pred = np.einsum("ij,ij->i", X, th[:, :-1]) + th[:, -1]
+    """One-step-ahead prediction from measured outputs: (yhat, regions), first max_lag measured/-1.
+    A prediction that overflows (output power terms of data far beyond the training range) is
+    inf or nan, without numpy's warnings: the caller says what it means."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        X, _ = structure.build(inputs, output, fit=False)
+        regions = partition.predict(X)
+        th = np.asarray(theta)[regions]
+        pred = np.einsum("ij,ij->i", X, th[:, :-1]) + th[:, -1]
     m = structure.max_lag
     y = np.asarray(output, dtype=float)
     yhat = np.concatenate([y[:m], pred])
