@@ -483,8 +483,12 @@ def test_a_closed_stdout_still_writes_the_model_and_a_long_suffix_is_an_error(tm
     monkeypatch.setattr("sys.stdout", None)  # started with >&-
     status = main(["identify", str(tmp_path / "d.csv"), "--input", "u1", "--input", "u2", "--output", "y",
                    "--na", "2", "--nb", "2", "--segmentation", "average", "--out", str(tmp_path / "m.json")])
-    monkeypatch.undo()
     assert status == 0 and (tmp_path / "m.json").exists()
+    # a table asked on standard output, with nowhere to go: one line before any work (a traceback)
+    for args in (["predict", str(tmp_path / "m.json"), str(tmp_path / "d.csv"), "--out", "-"],
+                 ["plant", "sweep", "--out", "-"]):
+        assert main(args) == 2
+    monkeypatch.undo()
     write_text_atomic(tmp_path / ("x." + "b" * 215), "{}")  # it looped for ever cutting the name
     assert (tmp_path / ("x." + "b" * 215)).read_text() == "{}"
     with pytest.raises(DataError, match="cannot write there"):

@@ -144,3 +144,13 @@ def test_a_mat_matrix_column_and_a_variable_of_its_name_are_refused(tmp_path):
 def test_a_text_variable_does_not_clash_with_a_matrix_column(tmp_path):
     savemat(tmp_path / "ok.mat", {"u": np.ones((10, 2)), "u_1": "a note", "y": np.arange(10.0)})
     assert sorted(read_table(tmp_path / "ok.mat")) == ["u_1", "u_2", "y"]
+
+
+def test_a_column_name_with_a_comma_or_a_quote_is_quoted_and_reads_back(tmp_path):
+    from hwpts.io.datasets import write_csv
+
+    path = tmp_path / "q.csv"
+    write_csv(path, {"u,raw": np.array([1.0, 2.0]), 'say "y"': np.array([3.0, 4.0])})
+    assert path.read_text().splitlines()[0] == '"u,raw","say ""y"""'
+    back = read_table(path)
+    assert list(back) == ["u,raw", 'say "y"'] and back["u,raw"].tolist() == [1.0, 2.0]

@@ -96,6 +96,10 @@ def file_with_suffix(*suffixes: str, stdout: bool = False):
     existing folder; ``-`` (standard output) too when ``stdout``."""
     def check(text: str) -> Path | str:
         if stdout and text == "-":
+            import sys
+
+            if sys.stdout is None:  # started with standard output closed (>&-): said before any work
+                raise argparse.ArgumentTypeError("standard output is closed; give a file name")
             return text
         if not text.strip():
             raise argparse.ArgumentTypeError("expected a file path, got an empty string")

@@ -229,11 +229,11 @@ def csv_text(columns: Mapping[str, np.ndarray], fmt: str | None = None) -> str:
     if len(n) > 1:
         raise DataError(f"columns have different lengths: { {k: a.shape[0] for k, a in zip(names, arrays)} }")
     buf = io.StringIO()
-    buf.write(",".join(names) + "\n")
-    formatted = [_cells(a, fmt) for a in arrays]
-    if formatted:
-        buf.write("\n".join(",".join(row) for row in zip(*formatted)))
-        buf.write("\n")
+    # the csv module quotes a name or text cell holding a comma, a quote or a line break (joined
+    # by hand, a column "u,raw" shifted every later column for any reader)
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(names)
+    writer.writerows(zip(*[_cells(a, fmt) for a in arrays]))
     return buf.getvalue()
 
 
@@ -253,6 +253,8 @@ def write_table(path: str | os.PathLike, columns: Mapping[str, np.ndarray]) -> N
     if is_stdout(path):
         import sys
 
+        if sys.stdout is None:  # started with standard output closed (>&-)
+            raise DataError("--out -: standard output is closed; give a file name")
         sys.stdout.write(csv_text(columns))
         sys.stdout.flush()
         return
