@@ -284,6 +284,9 @@ CASES = [
     (["validate", f"{W}/model.json", f"{W}/short.csv"], "short.csv"),
     (["validate", f"{W}/model.json", f"{W}/data.csv", "--input", "u1"], "--input"),
     (["validate", f"{W}/model.json", f"{W}/data.csv", "--output", "q"], "q"),
+    # the figure's path is --plot, not --out (the file writer named every output --out)
+    (["validate", f"{W}/model.json", f"{W}/data.csv", "--plot", f"{W}/afile/x.png"], "--plot '"),
+    (["residuals", f"{W}/model.json", f"{W}/data.csv", "--plot", f"{W}/afile/x.png"], "--plot '"),
     (["validate", f"{W}/model.json", f"{W}/data.csv", "--plot", f"{W}/v.jpg"], "--plot"),
     (["validate", f"{W}/model.json", f"{W}/data.csv", "--plot", f"{W}/folder/"], "--plot"),
     (["validate", f"{W}/model.json", f"{W}/data.csv", "--rows", "1:2:3"], "--rows"),

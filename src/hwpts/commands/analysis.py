@@ -22,7 +22,7 @@ def cmd_residuals(args) -> int:
         units = getattr(model, "units_", {}) or {}
         name = model.structure_.output_name
         write_bytes_atomic(args.plot, residual_figure(analysis, output_name=name, unit=units.get(name),
-                                                      title=f"{args.model} on {args.data}"))
+                                                      title=f"{args.model} on {args.data}"), argument="--plot")
         result["plot"] = str(args.plot)
     if args.json:
         print(json_text(result))

@@ -704,7 +704,7 @@ def _write_validation_plot(model, data, result, args):
         output_name=model.structure_.output_name, unit=units.get(model.structure_.output_name),
         fit_percent=result["fit_percent"], time_unit="s" if timed else None,
         title=f"{args.model} on {args.data}")
-    write_bytes_atomic(args.plot, png)
+    write_bytes_atomic(args.plot, png, argument="--plot")
 
 
 def cmd_predict(args) -> int:

@@ -120,19 +120,19 @@ def glob_escape(text: str) -> str:
 
 
 @contextlib.contextmanager
-def atomic_path(path: str | os.PathLike, suffix: str | None = None):
+def atomic_path(path: str | os.PathLike, suffix: str | None = None, argument: str = "--out"):
     """Yield a temporary path beside ``path``; on success rename it onto ``path``.
 
     On any exception (Ctrl-C and SIGTERM included) the temporary file is removed and ``path`` is
     left untouched. The file gets the permissions ``open()`` would give it (the umask's). A path
     that is a folder, a link, a device or a FIFO is refused; an operating-system error becomes a
-    :class:`DataError` naming the path.
+    :class:`DataError` naming the path (as the command's ``argument``).
     """
-    target = check_output_path(path)
+    target = check_output_path(path, argument)
     end = suffix if suffix is not None else target.suffix + ".tmp"
     blocker = next((a for a in target.parents if a.exists() or a.is_symlink()), None)
     if blocker is not None and not blocker.is_dir():
-        raise DataError(f"--out {str(target)!r}: expected a path in a folder, got {str(blocker)!r}, which is a file")
+        raise DataError(f"{argument} {str(target)!r}: expected a path in a folder, got {str(blocker)!r}, which is a file")
     created = [a for a in reversed(target.parents) if not (a.exists() or a.is_symlink())]
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
@@ -142,7 +142,7 @@ def atomic_path(path: str | os.PathLike, suffix: str | None = None):
         os.close(fd)
     except OSError as error:
         _remove_created(created)
-        raise DataError(f"--out {str(target)!r}: cannot write there ({error.strerror or error})") from None
+        raise DataError(f"{argument} {str(target)!r}: cannot write there ({error.strerror or error})") from None
     except BaseException:
         _remove_created(created)
         raise
@@ -156,7 +156,7 @@ def atomic_path(path: str | os.PathLike, suffix: str | None = None):
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
         _remove_created(created)
-        raise DataError(f"--out {str(target)!r}: cannot write there ({error.strerror or error})") from None
+        raise DataError(f"{argument} {str(target)!r}: cannot write there ({error.strerror or error})") from None
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
@@ -174,7 +174,7 @@ def write_text_atomic(path: str | os.PathLike, text: str, before_commit=None) ->
             before_commit()
 
 
-def write_bytes_atomic(path: str | os.PathLike, data: bytes) -> None:
-    """Write ``data`` to ``path`` atomically."""
-    with atomic_path(path) as tmp:
+def write_bytes_atomic(path: str | os.PathLike, data: bytes, argument: str = "--out") -> None:
+    """Write ``data`` to ``path`` atomically (errors name the path as the command's ``argument``)."""
+    with atomic_path(path, argument=argument) as tmp:
         tmp.write_bytes(data)
