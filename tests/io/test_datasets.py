@@ -154,3 +154,22 @@ def test_a_column_name_with_a_comma_or_a_quote_is_quoted_and_reads_back(tmp_path
     assert path.read_text().splitlines()[0] == '"u,raw","say ""y"""'
     back = read_table(path)
     assert list(back) == ["u,raw", 'say "y"'] and back["u,raw"].tolist() == [1.0, 2.0]
+
+
+def test_parquet_dates_and_times_of_day_are_read_in_seconds(tmp_path):
+    """A date32 column of days was read as 1 s a sample (its raw count); a time-of-day column
+    was not numeric and dropped as a time axis without a word."""
+    import datetime as dt
+
+    pa = pytest.importorskip("pyarrow")
+    pq = pytest.importorskip("pyarrow.parquet")
+    days = [dt.date(2026, 1, 1) + dt.timedelta(days=i) for i in range(3)]
+    clock = [(dt.datetime(2026, 1, 1) + dt.timedelta(milliseconds=10 * i)).time() for i in range(3)]
+    table = pa.table({"d32": pa.array(days, pa.date32()), "d64": pa.array(days, pa.date64()),
+                      "t64": pa.array(clock, pa.time64("us")), "t32": pa.array(clock, pa.time32("ms"))})
+    pq.write_table(table, tmp_path / "t.parquet")
+    cols = read_table(tmp_path / "t.parquet")
+    for name in ("d32", "d64"):
+        np.testing.assert_allclose(np.diff(cols[name]), 86400.0)
+    for name in ("t64", "t32"):
+        np.testing.assert_allclose(np.diff(cols[name]), 0.01)

@@ -294,11 +294,19 @@ def _read_parquet(p: Path, columns=None) -> dict[str, np.ndarray]:
         if columns is not None and name not in columns:
             continue
         column = table.column(i)
-        if pa.types.is_timestamp(column.type) or pa.types.is_duration(column.type):
-            # a time stamp or duration is read in seconds, whatever its unit (not its raw count)
-            per_second = {"s": 1.0, "ms": 1e3, "us": 1e6, "ns": 1e9}[column.type.unit]
-            ticks = column.cast(pa.int64()).to_numpy(zero_copy_only=False)
-            out[name] = np.asarray(ticks, dtype=float) / per_second
+        kind = column.type
+        if pa.types.is_timestamp(kind) or pa.types.is_duration(kind) or pa.types.is_time(kind) \
+                or pa.types.is_date(kind):
+            # a time stamp, duration, time of day or date is read in seconds, whatever its unit (not
+            # its raw count: a date32 column of days read as a sample time of 1 s, a time of day was dropped)
+            if pa.types.is_date32(kind):
+                per_second, ticks = 1.0 / 86400.0, column.cast(pa.int32())
+            elif pa.types.is_date64(kind):
+                per_second, ticks = 1e3, column.cast(pa.int64())
+            else:
+                per_second = {"s": 1.0, "ms": 1e3, "us": 1e6, "ns": 1e9}[kind.unit]
+                ticks = column.cast(pa.int32() if pa.types.is_time32(kind) else pa.int64())
+            out[name] = np.asarray(ticks.to_numpy(zero_copy_only=False), dtype=float) / per_second
             continue
         col = column.to_numpy(zero_copy_only=False)
         try:
