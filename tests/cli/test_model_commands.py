@@ -524,3 +524,17 @@ def test_data_without_a_time_column_is_taken_at_the_models_rate(tmp_path, capsys
     with open(tmp_path / "p.csv") as f:
         t = np.array([float(r["time_s"]) for r in csv.DictReader(f)])
     np.testing.assert_allclose(t, np.arange(300) * 0.01, atol=1e-12)
+
+
+def test_a_time_column_in_milliseconds_and_a_rate_s_unit_are_read_by_their_names(tmp_path, capsys):
+    """--time time_ms gave a sample time of 10 s for 10 ms steps; an output v_mm_s (mm/s) was
+    labelled s."""
+    d = make_system(5, rng=0, n=600)
+    path = tmp_path / "ms.csv"
+    write_csv(path, {"time_ms": np.arange(600) * 10.0, "u1": d.inputs[:, 0], "u2": d.inputs[:, 1],
+                     "v_mm_s": d.output})
+    assert main(["identify", str(path), "--input", "u1", "--input", "u2", "--output", "v_mm_s", "--na", "2",
+                 "--nb", "2", "--segmentation", "average", "--time", "time_ms", "--out", str(tmp_path / "m.json")]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["sample_time_s"] == pytest.approx(0.01)
+    assert summary["units"]["v_mm_s"] == "mm/s"

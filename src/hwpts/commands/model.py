@@ -125,6 +125,8 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
     detected = time_name is None and tname is not None
     hint = f" ({tname!r} is taken as the time column by its name; --time none uses the sample index)" if detected else ""
     timed = tname is not None
+    if timed and time_seconds(tname) != 1.0:  # a time column named in ms (time_ms), minutes, ...
+        cols[tname] = np.asarray(cols[tname], dtype=float) * time_seconds(tname)
     if tname is None:
         # time = sample index of the file (keeps the original numbering under --rows)
         cols["__index__"] = np.arange(len(columns[output_name]), dtype=float)[sl]
@@ -195,17 +197,40 @@ def _check_sample_time(model, data, dt, path, resample: bool):
 
 # units recognised from a column name's suffix (the plant's and the paper's naming: speed_rpm, ...)
 UNIT_SUFFIXES = {"_rpm": "r/min", "_v": "V", "_bar": "bar", "_s": "s", "_nm": "N m", "_mm": "mm",
-                 "_m": "m", "_hz": "Hz", "_w": "W", "_kw": "kW", "_pct": "%", "_lpm": "L/min", "_deg": "deg"}
+                 "_m": "m", "_hz": "Hz", "_w": "W", "_kw": "kW", "_pct": "%", "_lpm": "L/min", "_deg": "deg",
+                 "_rad": "rad", "_ms": "ms", "_pa": "Pa"}
+# a time column's unit by its suffix, in seconds (a name without one is in seconds)
+TIME_SUFFIXES = {"_ms": 1e-3, "_us": 1e-6, "_ns": 1e-9, "_min": 60.0, "_h": 3600.0}
+
+
+def time_seconds(name: str) -> float:
+    """Seconds per unit of a time column named ``name``: ``time_ms`` is in milliseconds."""
+    low = str(name).lower()
+    return next((v for k, v in TIME_SUFFIXES.items() if low.endswith(k)), 1.0)
+
+
+def _unit_of(name: str) -> str | None:
+    """A signal's unit from its name's suffix: ``speed_rpm`` r/min; ``v_mm_s`` mm/s (a rate:
+    another unit before ``_s``; it was labelled s)."""
+    low = str(name).lower()
+    for suffix, unit in UNIT_SUFFIXES.items():
+        if low.endswith(suffix):
+            if suffix == "_s":
+                before = low[:-2]
+                inner = next((u for k, u in UNIT_SUFFIXES.items() if k != "_s" and before.endswith(k)), None)
+                if inner is not None:
+                    return f"{inner}/s"
+            return unit
+    return None
 
 
 def _units(names, given) -> dict:
     """Units of the named signals: ``--unit NAME=UNIT`` first, else from the name's suffix."""
     units = {}
     for name in names:
-        for suffix, unit in UNIT_SUFFIXES.items():
-            if name.lower().endswith(suffix):
-                units[name] = unit
-                break
+        unit = _unit_of(name)
+        if unit is not None:
+            units[name] = unit
     for text in given or ():
         name, sep, unit = str(text).partition("=")
         if not sep or not name.strip() or not unit.strip():
