@@ -23,6 +23,7 @@ from hwpts.io.atomic import INTERRUPTED as _INTERRUPTED  # set by SIGINT/SIGTERM
 EXIT_OK = 0
 EXIT_USAGE = 2
 _INTERRUPTED_FRAMES: list = []  # see _run: interrupted runs' exceptions, kept until the process ends
+_SETTLED = threading.Event()  # the run has its status (outputs settled): a later signal is not raised
 
 
 class ArgumentParser(argparse.ArgumentParser):
@@ -79,8 +80,8 @@ def _check_outputs(args) -> None:
 
 def _interrupt(signum, frame):  # pragma: no cover - exercised in a subprocess test
     _INTERRUPTED.set()
-    if _COMMITTING.is_set():  # inside a commit: recorded, raised by no one (the commit completes)
-        return
+    if _COMMITTING.is_set() or _SETTLED.is_set():  # inside a commit, or the run is over: recorded,
+        return  # raised by no one (the commit completes; the status stands)
     raise KeyboardInterrupt
 
 
@@ -111,13 +112,16 @@ def main(argv: Sequence[str] | None = None) -> int:
         for sig in (signal.SIGINT, signal.SIGTERM):
             previous[sig] = signal.signal(sig, _interrupt)
         sys.unraisablehook = _quiet_interrupts(hook)
+    _SETTLED.clear()
     try:
         return _run(argv)
     finally:
+        _SETTLED.set()  # restoring the handlers below is no place for a KeyboardInterrupt
         for sig, handler in previous.items():
             signal.signal(sig, handler)
         sys.unraisablehook = hook
         _INTERRUPTED.clear()
+        _SETTLED.clear()
 
 
 # options whose value may start with a minus sign (a negative coefficient, a slice from the end):
@@ -148,22 +152,52 @@ def _run(argv: Sequence[str] | None) -> int:
     """Parse and dispatch; every failure becomes one line and an exit status. The parser is built
     here, after the signal handlers are in place: building it imports the command modules (numpy
     and more), and a Ctrl-C or SIGTERM in that time is an interrupt like any other."""
+    args, before = None, {}
     try:
         given = list(sys.argv[1:] if argv is None else argv)
         args = build_parser().parse_args(_attach_negative_values(given))
         args.command_line = shlex.join(["hwpts", *given])
+        before = _outputs(args)
         _check_outputs(args)
         status = int(args.handler(args) or EXIT_OK)
+        _SETTLED.set()  # a signal from here on arrives after the run: its status stands
     except BaseException as error:
         if isinstance(error, KeyboardInterrupt) or (_INTERRUPTED.is_set() and isinstance(error, Exception)):
             # the interrupted frames stay referenced until the process ends: freeing them runs the
             # destructors of whatever they held, and a compiler (LLVM under numba) stopped mid-way
             # can crash there (exit -11 right after this line, seen once under SIGTERM)
             _INTERRUPTED_FRAMES.append(error)
-            print("hwpts: interrupted", file=sys.stderr)
+            written = _written_since(args, before)
+            # a stop that lands after an output was committed cannot undo it: say so
+            print("hwpts: interrupted" + (f" after writing {', '.join(written)}" if written else ""), file=sys.stderr)
             return 130
         return _report(error)
     return status
+
+
+def _outputs(args) -> dict:
+    """``{path: (inode, mtime)}`` of the command's outputs (``--out``, ``--plot``) as they are now
+    (``None`` for one that does not exist)."""
+    found = {}
+    for name in ("out", "plot"):
+        value = getattr(args, name, None)
+        if value is None or str(value) == "-":
+            continue
+        try:
+            st = os.stat(value)
+            found[str(value)] = (st.st_ino, st.st_mtime_ns)
+        except (OSError, ValueError):
+            found[str(value)] = None
+    return found
+
+
+def _written_since(args, before: dict) -> list[str]:
+    """The outputs that changed since ``before`` (:func:`_outputs`): a run stopped after its
+    commit has a complete file there, and the user should know it."""
+    if args is None:
+        return []
+    now = _outputs(args)
+    return [path for path, state in now.items() if state is not None and state != before.get(path)]
 
 
 def _one_line(text: str) -> str:

@@ -514,3 +514,24 @@ def test_run_folders_never_swallow_their_input_a_link_or_the_current_folder(tmp_
     assert main(["reproduce", "--quick", "--out", "."]) == 2
     assert "is (or holds) the current folder" in capsys.readouterr().err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["link", "run"]
+
+
+def test_a_stop_after_the_commit_says_the_file_was_written(tmp_path, monkeypatch, capsys):
+    """A Ctrl-C landing just after the model file was committed cannot undo it: the run ends as
+    interrupted (130) and says which file it wrote (it said 'interrupted' beside a complete file)."""
+    import hwpts.io.models as models
+
+    d = make_system(5, rng=0, n=300)
+    write_csv(tmp_path / "d.csv", {"u1": d.inputs[:, 0], "u2": d.inputs[:, 1], "y": d.output})
+    save = models.save_model
+
+    def save_then_stop(*args, **kwargs):
+        save(*args, **kwargs)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(models, "save_model", save_then_stop)
+    status = main(["identify", str(tmp_path / "d.csv"), "--input", "u1", "--input", "u2", "--output", "y",
+                   "--na", "2", "--nb", "2", "--segmentation", "average", "--out", str(tmp_path / "m.json")])
+    err = capsys.readouterr().err.strip()
+    assert status == 130 and (tmp_path / "m.json").exists()
+    assert err == f"hwpts: interrupted after writing {tmp_path / 'm.json'}"
