@@ -80,6 +80,13 @@ def workspace(tmp_path_factory):
         "dt.json": _edited_model(doc, lambda m: m["signals"].__setitem__("sample_time_s", -1)),
         "units.json": _edited_model(doc, lambda m: m["signals"].__setitem__("units", [1, 2])),
         "cov.json": _edited_model(doc, lambda m: m["regions"][0].__setitem__("theta_covariance", [[1]])),
+        # found by a review (2026-11-26): these loaded (a number as text, settings outside the checksum)
+        "textnumber.json": _edited_model(doc, lambda m: m["regions"][0].__setitem__(
+            "theta", [str(v) for v in m["regions"][0]["theta"]])),
+        "ridge.json": _edited_model(doc, lambda m: m["settings"].__setitem__("ridge", "x")),
+        "nregions.json": _edited_model(doc, lambda m: m["settings"].__setitem__("n_regions", -3)),
+        "kind.json": _edited_model(doc, lambda m: m["partition"].__setitem__("kind", ["a"])),
+        "outname.json": _edited_model(doc, lambda m: m["structure"].__setitem__("output_name", m["structure"]["input_names"][0])),
         "inputs.csv": "time_s,valve_voltage_v,pump_speed_rpm\n0,2.4,700\n0.5,2.4,700\n1.0,2.5,700\n",
         "inputs_missing.csv": "time_s,valve_voltage_v\n0,2.4\n1,2.4\n",
         "inputs_huge.csv": "time_s,valve_voltage_v,pump_speed_rpm\n0,1e308,700\n1,2.4,700\n",
@@ -275,6 +282,11 @@ CASES = [
     (["validate", f"{W}/dt.json", f"{W}/data.csv"], "dt.json"),
     (["validate", f"{W}/units.json", f"{W}/data.csv"], "units.json"),
     (["validate", f"{W}/cov.json", f"{W}/data.csv"], "cov.json"),
+    (["validate", f"{W}/textnumber.json", f"{W}/data.csv"], "regions[0].theta must be"),
+    (["validate", f"{W}/ridge.json", f"{W}/data.csv"], "settings: ridge must be a number"),
+    (["export", f"{W}/nregions.json", "--format", "json", "--out", f"{W}/ss.json"], "settings: n_regions must be an int >= 1"),
+    (["validate", f"{W}/kind.json", f"{W}/data.csv"], "partition.kind must be a string"),
+    (["export", f"{W}/outname.json", "--format", "json", "--out", f"{W}/ss.json"], "is also an input's name"),
     (["validate", f"{W}/garbage.csv", f"{W}/data.csv"], "garbage.csv"),
     # --- validate: the data
     (["validate", f"{W}/model.json", f"{W}/missing.csv"], "missing.csv"),

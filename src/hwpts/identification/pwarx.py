@@ -224,13 +224,17 @@ class PWARX(BaseEstimator):
     def _check_settings(self):
         """One line naming the setting, what it takes and what it got, before any fit (the orders,
         regions and rows are checked where they are used)."""
-        from hwpts.identification.settings import check_bool, check_count, check_number
+        from hwpts.identification.settings import check_bool, check_count, check_number, is_count
 
         for name in ("constant", "polish", "sparse_partition"):
             check_bool(getattr(self, name), name)
         check_number(self.ridge, "ridge")
         check_number(self.classifier_C, "classifier_C", strict=True)
         check_count(self.refinement_rounds, "refinement_rounds", 0)
+        for name in ("max_rows", "classifier_rows"):
+            value = getattr(self, name)
+            if value is not None and not is_count(value, 100):
+                raise ParameterError(f"{name} must be None or an int >= 100, got {value!r}")
         if self.segmentation_params is not None and not isinstance(self.segmentation_params, Mapping):
             raise ParameterError(f"segmentation_params must be a dict of the method's settings or None, "
                                  f"got {self.segmentation_params!r}")
@@ -341,11 +345,6 @@ class PWARX(BaseEstimator):
                 raise ParameterError(f"n_regions must be an int >= 1 for {self.segmentation!r}, got {n_regions!r}")
         X_seg, y_seg = X_reg, target
         limit = self.max_rows
-        if limit is not None and (isinstance(limit, bool) or not isinstance(limit, (int, np.integer)) or limit < 100):
-            raise ParameterError(f"max_rows must be None or an int >= 100, got {limit!r}")
-        crows = self.classifier_rows
-        if crows is not None and (isinstance(crows, bool) or not isinstance(crows, (int, np.integer)) or crows < 100):
-            raise ParameterError(f"classifier_rows must be None or an int >= 100, got {crows!r}")
         if segmenter.learns_partition and limit is not None and X_reg.shape[0] > limit:
             rows = np.sort(rng.choice(X_reg.shape[0], int(limit), replace=False))
             X_seg, y_seg = X_reg[rows], target[rows]

@@ -215,9 +215,17 @@ def _has_bool(value) -> bool:
     return isinstance(value, list) and any(_has_bool(v) for v in value)
 
 
+def _has_text(value) -> bool:
+    if isinstance(value, str):
+        return True
+    return isinstance(value, list) and any(_has_text(v) for v in value)
+
+
 def _numbers(value, shape_desc: str, where: str) -> np.ndarray:
     if _has_bool(value):
-        raise DataError(f"{where} must be {shape_desc} of numbers, got true/false")
+        raise DataError(f"{where} must be {shape_desc} (JSON numbers), got true/false")
+    if _has_text(value):  # numpy reads "0.5" as 0.5: a JSON number written as text is no number
+        raise DataError(f"{where} must be {shape_desc} (JSON numbers), got text")
     try:
         arr = np.asarray(value, dtype=float)
     except (TypeError, ValueError, OverflowError):
@@ -249,6 +257,8 @@ def _check_structure_types(st: dict) -> None:
     twice = sorted({x for x in names if names.count(x) > 1})
     if twice:
         raise DataError(f"structure.input_names names {twice[0]!r} twice")
+    if st["output_name"] in names:
+        raise DataError(f"structure.output_name {st['output_name']!r} is also an input's name")
 
     if not isinstance(st["constant"], bool):
         raise DataError(f"structure.constant must be true or false, got {st['constant']!r}"[:200])
@@ -369,7 +379,10 @@ def model_from_dict(doc: dict):
             raise DataError(f"partition.polyhedra[{i}].g must have {h.shape[0]} numbers, got {gi.size}")
         H.append(h)
         g.append(gi)
-    partition = RegionPartition(H, g, kind=str(part_doc.get("kind", "polyhedra")))
+    kind = part_doc.get("kind", "polyhedra")
+    if not isinstance(kind, str):
+        raise DataError(f"partition.kind must be a string, got {kind!r}"[:200])
+    partition = RegionPartition(H, g, kind=kind)
     training = _require(doc, "training", dict, "the model")
     out_range = _numbers(_require(training, "output_range", list, "training"), "2 numbers", "training.output_range")
     if out_range.shape != (2,) or out_range[0] > out_range[1]:
@@ -400,4 +413,19 @@ def model_from_dict(doc: dict):
     if unknown:
         raise DataError(f"settings has unknown keys {unknown}; valid are {list(SETTINGS)}")
     model.set_params(**settings)
+    _check_settings(model, settings)
     return model
+
+
+def _check_settings(model, settings: dict) -> None:
+    """The settings section by what the estimator takes (it is not under the checksum): a file
+    that said ``"ridge": "x"`` or ``"n_regions": -3`` loaded and failed at the refit."""
+    from hwpts.identification.settings import is_count
+
+    try:
+        if "n_regions" in settings and not is_count(settings["n_regions"], 1):
+            raise ParameterError(f"n_regions must be an int >= 1, got {settings['n_regions']!r}")
+        model._check_settings()
+        model._segmenter()  # the method's name and its own settings
+    except HwptsError as error:
+        raise DataError(f"settings: {error}"[:300]) from None
