@@ -161,6 +161,10 @@ CASES = [
     (["identify", f"{W}/data.csv", *FIT, "--na", "2", "--nb", "2", "--regions", "1_0", "--out", f"{W}/m.json"],
      "--regions expects an int"),
     (["plant", "steady-state", "--valve-voltage", "2.4", "--pump-speed", "7_00"], "--pump-speed: expected a number, got '7_00'"),
+    (["identify", f"{W}/data.csv", *FIXED, "--ridge", "1e308", "--out", f"{W}/m.json"], "--ridge: expected a number from 0 to 1e+12"),
+    (["identify", "", *FIXED, "--out", f"{W}/m.json"], "DATA: expected a data file path, got an empty string"),
+    (["identify", f"{W}/data.csv", *FIXED, "--out", f"{W}/{'a' * 300}.json"], "argument --out: cannot write"),
+    (["identify", f"{W}/{'a' * 300}.csv", *FIXED, "--out", f"{W}/m.json"], "cannot read (File name too long)"),
     # 1e308 r/min of sensor noise overflowed to inf and was reported as a bad output column
     (["plant", "simulate", "--case", "case1", "--out", f"{W}/sim.csv", "--noise-std", "1e308"], "--noise-std: expected r/min"),
     # a text column named "time" beside a numeric t_s: the t_s axis is read, at another rate than the model's

@@ -86,7 +86,11 @@ def output_file(text: str) -> Path | str:
     if text == "-":
         return text
     path = Path(text)
-    if path.is_dir():
+    try:
+        folder = path.is_dir()
+    except OSError as error:  # a name too long for the file system
+        raise argparse.ArgumentTypeError(f"cannot write {text!r} ({error.strerror or error})") from None
+    if folder:
         raise argparse.ArgumentTypeError(f"expected a file path, got {text!r}, which is a folder")
     return path
 

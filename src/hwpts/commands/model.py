@@ -22,6 +22,18 @@ def _int_list(text: str, name: str):
     return values[0] if len(values) == 1 else values
 
 
+def _ridge(text: str) -> float:
+    import argparse
+
+    from hwpts.commands._args import non_negative_float
+    from hwpts.identification.pwarx import MAX_RIDGE
+
+    value = non_negative_float(text)
+    if value > MAX_RIDGE:
+        raise argparse.ArgumentTypeError(f"expected a number from 0 to {MAX_RIDGE:g}, got {text!r}")
+    return value
+
+
 def _output_powers(text: str):
     """``--output-powers``: ``"auto"`` (the search tries them), ``()`` for ``none``, or the powers given."""
     from hwpts.identification.regressors import MAX_POWER, check_output_powers
@@ -80,7 +92,11 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
     """
     from hwpts.dataset import IODataset
     from hwpts.io.datasets import numeric_share, read_table
+    from hwpts.io.paths import check_input_file
 
+    if not str(path).strip():
+        raise ParameterError("DATA: expected a data file path, got an empty string")
+    check_input_file(path, expected="a .csv, .parquet or .mat file")  # the file's own problem first
     for flag, names in (("--input", input_names), ("--output", [output_name])):
         if any(not str(name).strip() for name in names):
             raise ParameterError(f"{flag}: expected a column name, got an empty one")
@@ -854,7 +870,7 @@ def register(subparsers):
     p.add_argument("--all-partition-columns", action="store_true",
                    help="keep every allowed column in a learned partition (default: drop the columns its "
                         "boundaries hardly use)")
-    p.add_argument("--ridge", type=non_negative_float, default=0.0,
+    p.add_argument("--ridge", type=_ridge, default=0.0,
                    help="ridge penalty of the local least squares (relative to the regressors' scale; default 0)")
     p.add_argument("--polish", action="store_true", help="refine parameters on the free-run simulation error")
     p.add_argument("--scoring", choices=["auto", "free-run", "one-step"], default="auto",

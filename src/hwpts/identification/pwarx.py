@@ -49,6 +49,8 @@ from hwpts.identification.statespace import mode_state_space
 
 __all__ = ["PWARX", "FreeRunDivergedWarning"]
 
+MAX_RIDGE = 1e12  # ridge 1e308 overflowed the normal equations (a LinAlgError in every candidate)
+
 DIVERGENCE_FACTOR = 50.0
 
 
@@ -229,6 +231,9 @@ class PWARX(BaseEstimator):
         for name in ("constant", "polish", "sparse_partition"):
             check_bool(getattr(self, name), name)
         check_number(self.ridge, "ridge")
+        if self.ridge > MAX_RIDGE:  # relative to the regressors' scale: beyond it every parameter is 0
+            raise ParameterError(f"ridge must be at most {MAX_RIDGE:g} (relative to the regressors' scale), "
+                                 f"got {self.ridge!r}")
         check_number(self.classifier_C, "classifier_C", strict=True)
         check_count(self.refinement_rounds, "refinement_rounds", 0)
         for name in ("max_rows", "classifier_rows"):

@@ -127,7 +127,10 @@ def numeric_share(path: str | os.PathLike, column: str) -> float:
     a file without that column): a time column of numbers with one mistyped cell (near 1) is a
     broken time axis, a column of dates or labels (near 0) is not a time axis at all."""
     p = Path(path)
-    if p.suffix.lower() != ".csv" or not p.is_file():  # (a FIFO would block the read)
+    try:
+        if p.suffix.lower() != ".csv" or not p.is_file():  # (a FIFO would block the read)
+            return 0.0
+    except OSError:  # a name too long, a folder we may not search
         return 0.0
     try:
         text = p.read_text(encoding="utf-8-sig", errors="replace")
