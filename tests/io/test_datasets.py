@@ -173,3 +173,15 @@ def test_parquet_dates_and_times_of_day_are_read_in_seconds(tmp_path):
         np.testing.assert_allclose(np.diff(cols[name]), 86400.0)
     for name in ("t64", "t32"):
         np.testing.assert_allclose(np.diff(cols[name]), 0.01)
+
+
+def test_an_epoch_time_axis_gives_the_sample_time_it_was_sampled_at():
+    """Steps of an epoch axis (1.7e9 s) are rounded to 2.4e-7 s each: the median step read
+    0.000999927520752 s for 1 ms; the mean over the record, to the digits its resolution allows,
+    is 0.001."""
+    from hwpts.dataset import IODataset
+
+    for time, step in ((1.7e9 + np.arange(1000) * 0.001, 0.001), (np.arange(1000) * 0.01, 0.01),
+                       (0.5 + np.arange(100) * 1e-4, 1e-4)):
+        data = IODataset(time, np.zeros((time.size, 1)), np.arange(time.size, dtype=float), ["u"], "y")
+        assert data.uniform_sample_time() == step
