@@ -222,7 +222,7 @@ def test_a_killed_runs_staging_folder_is_removed_by_the_next_run(tmp_path):
 
 @pytest.mark.parametrize("extra, match", [
     (["--seed", "-1"], "argument --seed: expected a whole number >= 0, got '-1'"),
-    (["--ridge", "1e308"], "numerical failure"),
+    (["--ridge", "1e308"], "--ridge: expected a number from 0 to 1e+12"),
     (["--ridge", "-1"], "argument --ridge"),
 ])
 def test_values_checked_at_the_edge(tmp_path, data_csv, capsys, extra, match):

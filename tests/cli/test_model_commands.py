@@ -123,7 +123,7 @@ def test_nan_in_data(tmp_path, capsys):
     path.write_text("u,y\n" + "\n".join(f"{i % 7},{i % 5}" for i in range(30)) + "\nnan,1\n")
     out = tmp_path / "m.json"
     _expect_error(capsys, ["identify", str(path), "--input", "u", "--output", "y", "--na", "1", "--nb", "1",
-                           "--out", str(out)], "non-finite value (NaN, inf or an empty cell) at row 30", out)
+                           "--out", str(out)], "line 32, column 'u': expected a finite number, got 'nan'", out)
 
 
 def test_constant_input(tmp_path, capsys):
