@@ -171,11 +171,17 @@ def _local_cluster(LocalCluster, n_workers: int | None):
     or two the cluster takes to start is ignored (press it again); SIGTERM is not affected."""
     import logging
     import signal
+    import threading
 
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
-    try:
+    def start():
         return LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
                             dashboard_address=":0", silence_logs=logging.ERROR)
+
+    if threading.current_thread() is not threading.main_thread():  # only the main thread sets handlers
+        return start()
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        return start()
     finally:
         signal.signal(signal.SIGINT, previous)
 
