@@ -538,3 +538,17 @@ def test_a_time_column_in_milliseconds_and_a_rate_s_unit_are_read_by_their_names
     summary = json.loads(capsys.readouterr().out)
     assert summary["sample_time_s"] == pytest.approx(0.01)
     assert summary["units"]["v_mm_s"] == "mm/s"
+
+
+def test_a_column_whose_name_says_another_unit_than_the_models_is_refused(tmp_path, capsys):
+    """A model of pos_mm validated on pos_m (--output pos_m) scored -118055 % without a word on why."""
+    d = make_system(5, rng=0, n=600)
+    write_csv(tmp_path / "mm.csv", {"u1": d.inputs[:, 0], "u2": d.inputs[:, 1], "pos_mm": 1000 * d.output})
+    write_csv(tmp_path / "m.csv", {"u1": d.inputs[:, 0], "u2": d.inputs[:, 1], "pos_m": d.output,
+                                   "z_mm": 1000 * d.output})
+    assert main(["identify", str(tmp_path / "mm.csv"), "--input", "u1", "--input", "u2", "--output", "pos_mm",
+                 "--na", "2", "--nb", "2", "--segmentation", "average", "--out", str(tmp_path / "model.json")]) == 0
+    capsys.readouterr()
+    _expect_error(capsys, ["validate", str(tmp_path / "model.json"), str(tmp_path / "m.csv"), "--output", "pos_m"],
+                  "--output 'pos_m': the model's 'pos_mm' is in mm, and this column's name says m")
+    assert main(["validate", str(tmp_path / "model.json"), str(tmp_path / "m.csv"), "--output", "z_mm"]) == 0

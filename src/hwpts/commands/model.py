@@ -690,6 +690,21 @@ def _validate_numbers(model, data):
     return result
 
 
+def _check_mapped_units(model, inputs, output) -> None:
+    """A column mapped onto a model's signal (``--input``/``--output``) whose name says another unit
+    than the model's for that signal is refused: a model of ``pos_mm`` validated on ``pos_m``
+    scored -118055 % without a word on why."""
+    st = model.structure_
+    units = getattr(model, "units_", {}) or {}
+    pairs = [("--input", name, column) for name, column in zip(st.input_names, inputs)]
+    pairs.append(("--output", st.output_name, output))
+    for flag, name, column in pairs:
+        known, says = units.get(name), _unit_of(column)
+        if column != name and known and says and known != says:
+            raise DataError(f"{flag} {column!r}: the model's {name!r} is in {known}, and this column's name says "
+                            f"{says}; convert the data to {known} (or map a column in {known})")
+
+
 def _model_and_data(args):
     """The model and the data mapped onto its signals (by name, or by --input/--output), at its rate."""
     from hwpts.io.models import load_model
@@ -702,6 +717,7 @@ def _model_and_data(args):
                              f"{list(st.input_names)} (map each, in order)")
     output = args.output or st.output_name
     _check_signals(inputs, output)
+    _check_mapped_units(model, inputs, output)
     data, dt = _load_dataset(args.data, inputs, output, args.time, args.rows)
     data = _check_sample_time(model, data, dt, args.data, args.resample)
     st.check_length(data.n_samples, what=_selection(args, repr(str(args.data))))
