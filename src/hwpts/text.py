@@ -13,7 +13,7 @@ _INTEGER = re.compile(r"\s*[+-]?[0-9]+\s*")
 def plain_float(text) -> float:
     """A real number in Python's float syntax (``"1e-3"``, ``" -2.5 "``, ``"inf"``), without
     digit-group underscores or non-ASCII characters."""
-    text = str(text)
+    text = str(text).strip()  # surrounding spaces of any kind (a no-break space after a number)
     if "_" in text or not text.isascii():
         raise ValueError(text)
     return float(text)

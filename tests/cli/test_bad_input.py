@@ -332,7 +332,7 @@ CASES = [
     (["predict", f"{W}/clash.json", f"{W}/clash.csv", "--out", f"{W}/p.csv"],
      "the signal 'region' has the name of a column predict writes"),
     (["identify", f"{W}/noheader.csv", *FIXED, "--out", f"{W}/m.json"], "expected a header row of column names"),
-    (["identify", f"{W}/nantime.csv", *FIXED, "--out", f"{W}/m.json"], "line 7, column 't_s': expected a number, got an empty cell"),
+    (["identify", f"{W}/nantime.csv", *FIXED, "--out", f"{W}/m.json"], "the time column 't_s' has a non-finite value"),
     (["identify", f"{W}/zero.parquet", *FIXED, "--out", f"{W}/m.json"], "the file holds no data rows"),
     (["identify", f"{W}/data.csv", *FIXED, "--out", f"{W}/afile/deeper/m.json"], "which is a file"),
     (["validate", f"{W}/model.json", f"{W}/data.csv", "--rows", "0:3"], "(--rows 0:3) has 3 rows"),

@@ -122,7 +122,7 @@ def test_simulate_inputs_file(tmp_path, capsys):
     "content, fragments",
     [
         ("time_s,valve_voltage_v\n0,2\n0.01,2\n", ["missing column", "pump_speed_rpm"]),
-        ("time_s,valve_voltage_v,pump_speed_rpm\n0,2,500\n0.01,nan,500\n", ["line 3", "valve_voltage_v", "expected a finite number"]),
+        ("time_s,valve_voltage_v,pump_speed_rpm\n0,2,500\n0.01,nan,500\n", ["valve voltage", "non-finite", "row 1"]),
         ("time_s,valve_voltage_v,pump_speed_rpm\n0,2,500\n0,2,500\n", ["strictly increasing"]),
         ("time_s,valve_voltage_v,pump_speed_rpm\n0,2,500\n0.01,2,abc\n", ["line 3", "pump_speed_rpm", "'abc'"]),
         ("", ["empty file"]),

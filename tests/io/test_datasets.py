@@ -72,25 +72,28 @@ def test_bad_paths(tmp_path):
         read_table(tmp_path / "x.mat")
 
 
-def test_a_missing_value_is_refused_with_its_line(tmp_path):
-    """A missing cell (empty, "nan", "NA") is named by its line in the file, blank lines counted; a
-    row of empty fields is a row of missing values (the line-by-line reader dropped it, shifting
-    every later sample); a hexadecimal cell, which pyarrow reads as a number, is no number."""
+def test_missing_cells_are_nan_in_either_reader_and_a_hex_cell_is_refused_with_its_line(tmp_path):
+    """A missing cell (empty, "nan", "NA") is NaN whichever reader reads the file (the dataset
+    refuses it where the rows are used: --rows may leave it out); a row of empty fields is a row of
+    missing values (the line-by-line reader dropped it, shifting every later sample); a
+    hexadecimal cell, which pyarrow reads as a number, is no number; error lines count blank lines."""
     path = tmp_path / "n.csv"
-    path.write_text("u,y\n1,2\nnan,3\n")
-    with pytest.raises(DataError, match="line 3, column 'u': expected a finite number, got 'nan'"):
-        read_table(path)
-    path.write_text("u,y\n1,2\n\n\n2,NA\n")
-    with pytest.raises(DataError, match="line 5, column 'y': expected a number, got 'NA'"):
-        read_table(path)
+    for text in ("u,y\n1,2\nnan,3\n4,NA\n", "u,y,\n1,2,\nnan,3,\n4,NA,\n"):  # fast reader, line-by-line reader
+        path.write_text(text)
+        cols = read_table(path)
+        assert np.isnan(cols["u"][1]) and np.isnan(cols["y"][2]) and cols["u"][2] == 4.0
     path.write_text("u,y,\n1,2,\n,\n2,3,\n")  # the trailing commas send it to the line-by-line reader
-    with pytest.raises(DataError, match="line 3, column 'u': expected a number, got an empty cell"):
-        read_table(path)
+    assert np.isnan(read_table(path)["u"][1]) and read_table(path)["u"][2] == 2.0
     path.write_text("u,y\n1,2\n0x10,3\n")
     with pytest.raises(DataError, match="line 3, column 'u': expected a number, got '0x10'"):
         read_table(path)
-    path.write_text("u,y\n1,2\n \n2,3\n\n")  # blank lines are no rows
-    np.testing.assert_array_equal(read_table(path)["u"], [1.0, 2.0])
+    path.write_text("u,y,note\n1,2,id 0x2A\n3,4,b\n")  # a hex-looking text in a column not read
+    np.testing.assert_array_equal(read_table(path, ["u", "y"])["u"], [1.0, 3.0])
+    path.write_text("u,y\n1,2\n\n\n2,abc\n")
+    with pytest.raises(DataError, match="line 5, column 'y': expected a number, got 'abc'"):
+        read_table(path)
+    path.write_text("u,y\n1,2\n \n2,3\u00a0\n\n")  # blank lines are no rows; a no-break space is a space
+    np.testing.assert_array_equal(read_table(path)["y"], [2.0, 3.0])
 
 
 @pytest.mark.parametrize("text", [

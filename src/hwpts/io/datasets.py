@@ -103,23 +103,28 @@ def read_csv(path: str | os.PathLike, columns=None) -> dict[str, np.ndarray]:
         column = table.column(i)
         if not (pa.types.is_floating(column.type) or pa.types.is_integer(column.type) or pa.types.is_null(column.type)):
             return _read_csv_python(p, delimiter, columns)
-        if column.null_count:  # an empty or "NA" cell: the line-by-line reader names its line
-            return _read_csv_python(p, delimiter, columns)
-        if pa.types.is_integer(column.type) and _has_hex(p):  # pyarrow reads "0x10" as 16; no CSV writer means that
-            return _read_csv_python(p, delimiter, columns)
         # unsafe: an integer beyond 2^53 (a nanosecond epoch time) rounds to the nearest float
-        # instead of raising pyarrow's range error
+        # instead of raising pyarrow's range error; a missing cell is NaN (refused where it is used)
         out[name] = column.cast(pa.float64(), safe=False).to_numpy(zero_copy_only=False)
+    integers = [table.column_names[i] for i in wanted if pa.types.is_integer(table.column(i).type)]
+    if integers and _has_hex(p, delimiter, integers):  # pyarrow reads "0x10" as 16; no CSV writer means that
+        return _read_csv_python(p, delimiter, columns)  # refuses the cell, naming its line
     return out
 
 
-def _has_hex(p: Path) -> bool:
-    """Whether the file holds a hexadecimal literal's prefix anywhere (``0x``)."""
+def _has_hex(p: Path, delimiter: str, names: list[str]) -> bool:
+    """Whether a cell of the columns ``names`` (read as integers) was written in hexadecimal."""
+    import pyarrow as pa
+    import pyarrow.compute as pc
+    import pyarrow.csv as pacsv
+
     try:
-        data = p.read_bytes()
-    except OSError:
-        return False
-    return b"0x" in data or b"0X" in data
+        text = pacsv.read_csv(p, parse_options=pacsv.ParseOptions(delimiter=delimiter),
+                              convert_options=pacsv.ConvertOptions(include_columns=names,
+                                                                   column_types={n: pa.string() for n in names}))
+    except (pa.ArrowInvalid, OSError):
+        return True  # let the line-by-line reader say what it is
+    return any(pc.any(pc.match_substring(text.column(n), "x", ignore_case=True)).as_py() for n in names)
 
 
 def numeric_share(path: str | os.PathLike, column: str) -> float:
@@ -198,15 +203,20 @@ def _read_csv_python(p: Path, delimiter: str = ",", columns=None) -> dict[str, n
             )
         for j in wanted:
             cell = row[j]
+            if cell.strip() in MISSING:  # as the fast reader: NaN, refused only where the rows are used
+                values[k, j] = np.nan
+                continue
             try:
-                values[k, j] = value = plain_float(cell)
+                values[k, j] = plain_float(cell)
             except ValueError:
-                got = "an empty cell (a missing value)" if not cell.strip() else repr(cell.strip())
-                raise DataError(f"{str(p)!r} line {i}, column {header[j]!r}: expected a number, got {got}") from None
-            if not np.isfinite(value):
-                raise DataError(f"{str(p)!r} line {i}, column {header[j]!r}: expected a finite number, got "
-                                f"{cell.strip()!r} (a missing value)")
+                raise DataError(f"{str(p)!r} line {i}, column {header[j]!r}: expected a number, "
+                                f"got {cell.strip()!r}") from None
     return {header[j]: values[:, j].copy() for j in wanted}
+
+
+# the cells pyarrow's CSV reader reads as missing (null), read as NaN by the line-by-line reader too
+MISSING = frozenset(["", "#N/A", "#N/A N/A", "#NA", "-1.#IND", "-1.#QNAN", "-NaN", "-nan", "1.#IND", "1.#QNAN",
+                     "N/A", "NA", "NULL", "NaN", "n/a", "nan", "null"])
 
 
 def _cells(a: np.ndarray, fmt: str | None) -> list:
