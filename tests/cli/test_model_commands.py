@@ -538,6 +538,16 @@ def test_a_time_column_in_milliseconds_and_a_rate_s_unit_are_read_by_their_names
     summary = json.loads(capsys.readouterr().out)
     assert summary["sample_time_s"] == pytest.approx(0.01)
     assert summary["units"]["v_mm_s"] == "mm/s"
+    # a typed Parquet time stamp is in seconds already, whatever its name says (it was scaled twice)
+    pa = pytest.importorskip("pyarrow")
+    pq = pytest.importorskip("pyarrow.parquet")
+    ticks = 1_700_000_000_000_000 + np.arange(600) * 10_000
+    pq.write_table(pa.table({"time_us": pa.array(ticks, pa.timestamp("us")), "u1": d.inputs[:, 0],
+                             "u2": d.inputs[:, 1], "y": d.output}), tmp_path / "ts.parquet")
+    assert main(["identify", str(tmp_path / "ts.parquet"), "--input", "u1", "--input", "u2", "--output", "y",
+                 "--na", "2", "--nb", "2", "--segmentation", "average", "--time", "time_us",
+                 "--out", str(tmp_path / "m2.json")]) == 0
+    assert json.loads(capsys.readouterr().out)["sample_time_s"] == pytest.approx(0.01)
 
 
 def test_a_column_whose_name_says_another_unit_than_the_models_is_refused(tmp_path, capsys):
@@ -552,6 +562,11 @@ def test_a_column_whose_name_says_another_unit_than_the_models_is_refused(tmp_pa
     _expect_error(capsys, ["validate", str(tmp_path / "model.json"), str(tmp_path / "m.csv"), "--output", "pos_m"],
                   "--output 'pos_m': the model's 'pos_mm' is in mm, and this column's name says m")
     assert main(["validate", str(tmp_path / "model.json"), str(tmp_path / "m.csv"), "--output", "z_mm"]) == 0
+    # a unit given as free text (--unit y=rpm) is not compared with a column's name (r/min)
+    write_csv(tmp_path / "y.csv", {"u1": d.inputs[:, 0], "u2": d.inputs[:, 1], "y": d.output, "speed_rpm": d.output})
+    assert main(["identify", str(tmp_path / "y.csv"), "--input", "u1", "--input", "u2", "--output", "y", "--unit", "y=rpm",
+                 "--na", "2", "--nb", "2", "--segmentation", "average", "--out", str(tmp_path / "y.json")]) == 0
+    assert main(["validate", str(tmp_path / "y.json"), str(tmp_path / "y.csv"), "--output", "speed_rpm"]) == 0
 
 
 def test_a_missing_cell_outside_the_selected_rows_does_not_matter(tmp_path, capsys):

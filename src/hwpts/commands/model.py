@@ -91,7 +91,7 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
     applied silently to data sampled at another rate; ``time_name="none"`` uses the row index.
     """
     from hwpts.dataset import IODataset
-    from hwpts.io.datasets import numeric_share, read_table
+    from hwpts.io.datasets import numeric_share, read_table, temporal_columns
     from hwpts.io.paths import check_input_file
 
     if not str(path).strip():
@@ -141,7 +141,8 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
     detected = time_name is None and tname is not None
     hint = f" ({tname!r} is taken as the time column by its name; --time none uses the sample index)" if detected else ""
     timed = tname is not None
-    if timed and time_seconds(tname) != 1.0:  # a time column named in ms (time_ms), minutes, ...
+    if timed and time_seconds(tname) != 1.0 and tname not in temporal_columns(path):
+        # a column of numbers named in ms (time_ms), minutes, ...; a typed Parquet time is in seconds already
         cols[tname] = np.asarray(cols[tname], dtype=float) * time_seconds(tname)
     if tname is None:
         # time = sample index of the file (keeps the original numbering under --rows)
@@ -699,8 +700,9 @@ def _check_mapped_units(model, inputs, output) -> None:
     pairs = [("--input", name, column) for name, column in zip(st.input_names, inputs)]
     pairs.append(("--output", st.output_name, output))
     for flag, name, column in pairs:
+        # only a unit the model took from its signal's own name (--unit text is free: 'rpm', 'v')
         known, says = units.get(name), _unit_of(column)
-        if column != name and known and says and known != says:
+        if column != name and known and says and known == _unit_of(name) and known != says:
             raise DataError(f"{flag} {column!r}: the model's {name!r} is in {known}, and this column's name says "
                             f"{says}; convert the data to {known} (or map a column in {known})")
 

@@ -127,6 +127,22 @@ def _has_hex(p: Path, delimiter: str, names: list[str]) -> bool:
     return any(pc.any(pc.match_substring(text.column(n), "x", ignore_case=True)).as_py() for n in names)
 
 
+def temporal_columns(path: str | os.PathLike) -> set[str]:
+    """The columns of a Parquet file typed as time stamps, durations, dates or times of day (read in
+    seconds already, whatever their names say); none for another format."""
+    p = Path(path)
+    if p.suffix.lower() != ".parquet":
+        return set()
+    try:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        schema = pq.read_schema(p)
+    except Exception:  # noqa: BLE001 - an unreadable file is said by the reader
+        return set()
+    return {f.name for f in schema if pa.types.is_temporal(f.type)}
+
+
 def numeric_share(path: str | os.PathLike, column: str) -> float:
     """The share of a CSV column's non-empty cells that read as numbers (0 for another format or
     a file without that column): a time column of numbers with one mistyped cell (near 1) is a
