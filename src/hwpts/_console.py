@@ -4,8 +4,9 @@
 only once the command line's modules are imported: a signal in the first ~50 ms, while Python
 imports them, ended the process with a traceback (SIGINT) or silently with -15 (SIGTERM). Here
 both raise :class:`KeyboardInterrupt` from the first line of the script on, and after the run the
-process ignores them while it exits (the outputs are settled by then; the handlers main restores
-are those that ignore them). What is left is Python's
+process ignores them while it exits (the outputs are settled by then: a signal between main's
+return and that point is recorded by main's flag and not raised, so it cannot turn the run's
+status into 130 beside a complete output). What is left is Python's
 own start (about 15 ms here), where a SIGINT ends the process with status -2 and a message from
 the interpreter.
 """
@@ -17,6 +18,9 @@ import _signal  # the C module: ``signal`` imports ``enum`` first, 10 ms more of
 
 
 def _interrupt(signum, frame):
+    cli = sys.modules.get("hwpts.cli")
+    if cli is not None and cli._SETTLED.is_set():  # the run is over (main restored this handler):
+        return  # its status stands
     raise KeyboardInterrupt
 
 
@@ -33,12 +37,9 @@ def entry() -> None:  # pragma: no cover - the console script, exercised in subp
             _signal.signal(sig, _interrupt)
         from hwpts.cli import finish, main
 
-        # main installs its own handlers and restores these when it returns: ignoring, so that a
-        # signal after the run (its outputs settled) no longer turns its status into 130 (it did,
-        # in the instant between main's return and the line after, with the model file written)
+        status = main()  # main restores these handlers, which then leave a late signal alone (_interrupt)
         for sig in (_signal.SIGINT, _signal.SIGTERM):
             _signal.signal(sig, _signal.SIG_IGN)
-        status = main()
     except KeyboardInterrupt:
         _interrupted()
     finish(status)

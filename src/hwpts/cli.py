@@ -120,8 +120,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         for sig, handler in previous.items():
             signal.signal(sig, handler)
         sys.unraisablehook = hook
-        _INTERRUPTED.clear()
-        _SETTLED.clear()
+        _INTERRUPTED.clear()  # (_SETTLED stays set until the next run: the console script's handlers read it)
 
 
 # options whose value may start with a minus sign (a negative coefficient, a slice from the end):

@@ -816,8 +816,9 @@ def cmd_predict(args) -> int:
 
 def _common_data_args(parser):
     parser.add_argument("--time", metavar="COL", default=None,
-                        help="time column [s] (default: the first of time_s, t_s, time, t present, else the "
-                             "sample index; 'none': the sample index); its step is the sample time")
+                        help="time column, in s unless its name ends in _ms, _us, _ns, _min or _h (default: the "
+                             "first of time_s, t_s, time, t present, else the sample index; 'none': the sample "
+                             "index); its step is the sample time")
     parser.add_argument("--rows", metavar="START:STOP", default=None,
                         help="use only these rows (Python slice: 0:5000; write --rows=-1001: for a negative start)")
 
@@ -889,7 +890,8 @@ def register(subparsers):
                    help="keep every allowed column in a learned partition (default: drop the columns its "
                         "boundaries hardly use)")
     p.add_argument("--ridge", type=_ridge, default=0.0,
-                   help="ridge penalty of the local least squares (relative to the regressors' scale; default 0)")
+                   help="ridge penalty of the local least squares (relative to the regressors' scale, 0 to "
+                        "1e12; default 0)")
     p.add_argument("--polish", action="store_true", help="refine parameters on the free-run simulation error")
     p.add_argument("--scoring", choices=["auto", "free-run", "one-step"], default="auto",
                    help="what ranks the candidate models on the held-out blocks (default auto: the free-run "
