@@ -582,3 +582,6 @@ def test_a_missing_cell_outside_the_selected_rows_does_not_matter(tmp_path, caps
         capsys.readouterr()
         _expect_error(capsys, ["identify", str(path), *IDENTIFY, "--segmentation", "average",
                                "--out", str(tmp_path / "m2.json")], "non-finite value")
+        # inside a selection, the row is the file's (as --rows counts), not the selection's
+        _expect_error(capsys, ["identify", str(path), *IDENTIFY, "--segmentation", "average", "--rows", "300:",
+                               "--out", str(tmp_path / "m2.json")], "at row 600 (data rows count from 0")

@@ -137,6 +137,12 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
     if n == 0:
         where = f"no rows selected (--rows {rows})" if rows is not None else "the file holds no data rows"
         raise DataError(f"{str(path)!r}: {where}")
+    offset = range(total)[sl].start  # the file's data row of the selection's first (--rows counts from 0)
+    for name in signals:
+        bad = ~np.isfinite(np.asarray(cols[name], dtype=float))
+        if bad.any():  # said in the file's rows (the dataset counts within the selection)
+            raise DataError(f"{str(path)!r}: column {name!r} has a non-finite value (NaN, inf or an empty cell) at "
+                            f"row {offset + int(np.argmax(bad))} (data rows count from 0 after the header, as --rows)")
     tname = next((c for c in candidates if c in cols), None)
     detected = time_name is None and tname is not None
     hint = f" ({tname!r} is taken as the time column by its name; --time none uses the sample index)" if detected else ""
