@@ -107,6 +107,23 @@ def test_model_inputs_must_be_valve_and_pump():
     doc["structure"]["input_names"] = ["u1", "u2"]
     with pytest.raises(DataError, match="valve voltage and the pump speed"):
         ModelBank(doc)
+    # a model of motor B's speed designed controllers that steered motor A, and called one the best
+    doc = _two_region_doc()
+    doc["structure"]["output_name"] = "motor_b_speed_rpm"
+    with pytest.raises(DataError, match="output must be the main motor's"):
+        ModelBank(doc)
+
+
+def test_controller_lists_have_no_empty_names_and_scheduler_ports_are_ports():
+    from hwpts.control.controllers import parse_names
+    from hwpts.control.study import is_address
+    from hwpts.errors import ParameterError
+
+    assert parse_names(" pi , mpc ") == ["pi", "mpc"]
+    for text in ("pi,,mpc", "pi,"):
+        with pytest.raises(ParameterError, match="an empty name"):
+            parse_names(text)
+    assert is_address("tcp://127.0.0.1:8786") and not is_address("tcp://127.0.0.1:99999")
 
 
 def test_low_wind_no_windup_and_recovery(paper_model_doc):

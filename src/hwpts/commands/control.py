@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 
 from hwpts.commands._args import finite_float, non_negative_int
@@ -199,7 +200,9 @@ def study_command(args) -> int:
         # that target was dropped in silence (the same controller met the targets or not as pi was
         # listed)
         names = ["pi", *names]
-        print("control study: pi added to --controllers (the baseline of the 30 % RMS target)", file=sys.stderr)
+        added_pi = True  # said once the study has run (before, it made a second line beside an error)
+    else:
+        added_pi = False
     check_replaceable(args.out, STUDY_SCHEMA)
     start = time.perf_counter()
     _, doc, sample_time, half_width, source = _model_bank(args)
@@ -211,7 +214,15 @@ def study_command(args) -> int:
                "plant_tolerances": PLANT_TOLERANCES, "model": {"source": source, "sample_time_s": sample_time,
                                                                "hysteresis_half_width_v": half_width},
                "scheduler": args.scheduler or "local cluster", "timings_s": {}}
-    best = max(result.summary, key=lambda n: result.summary[n]["plants_meeting_targets_share"] or 0.0)
+    if added_pi:
+        print("control study: pi added to --controllers (the baseline of the 30 % RMS target)", file=sys.stderr)
+
+    def rank(name):  # the most plants meeting the targets; among equals, the lower median RMS error
+        row = result.summary[name]
+        median = row.get("median_rms_error_percent")
+        return (row["plants_meeting_targets_share"] or 0.0, -(median if median is not None else math.inf))
+
+    best = max(result.summary, key=rank)
     summary["best"] = best
     with staged_folder(args.out, STUDY_SCHEMA) as stage:
         cols = {k: [r[k] for r in result.rows] for k in result.rows[0]}

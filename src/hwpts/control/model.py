@@ -26,6 +26,7 @@ FLAT_GAIN_SHARE = 0.2
 
 VALVE_WORDS = ("valve",)
 PUMP_WORDS = ("pump",)
+OTHER_OUTPUT_WORDS = ("motor_b", "pump", "pressure", "valve", "spool")  # an output that is not motor A's speed
 
 
 @dataclass(frozen=True)
@@ -71,6 +72,10 @@ class ModelBank:
                             f"the model has inputs {names}")
         self.input_names = tuple(names)
         self.output_name = str(st["output_name"])
+        if any(w in self.output_name.lower() for w in OTHER_OUTPUT_WORDS):
+            # a model of motor B's speed (or a pressure) designed controllers that steered motor A
+            raise DataError(f"the model's output must be the main motor's (motor A's) speed, which the controllers "
+                            f"hold; the model's output is {self.output_name!r}")
         self.sample_time = float(sample_time)
         self.na = int(st["na"])
         nb, nk = st["nb"], st["nk"]

@@ -126,7 +126,8 @@ def is_address(text: str) -> bool:
     """Whether ``text`` is a scheduler address hwpts connects to: ``tcp://HOST:PORT`` or ``HOST:PORT``."""
     import re
 
-    return bool(re.fullmatch(r"(tcp://)?[A-Za-z0-9_.\-\[\]:]+:\d{1,5}", str(text)))
+    found = re.fullmatch(r"(tcp://)?[A-Za-z0-9_.\-\[\]:]+:(\d{1,5})", str(text))
+    return bool(found) and 1 <= int(found.group(2)) <= 65535  # a port number (99999 waited 10 s to fail)
 
 
 def _connect(Client, scheduler: str):

@@ -27,9 +27,11 @@ _CLASSES = {"pi": PIController, "scheduled": ScheduledController, "mmac": MMACCo
 
 def parse_names(text: str) -> list[str]:
     """'a,b,...' -> names, each checked against the registry."""
-    names = [n.strip() for n in str(text).split(",") if n.strip()]
-    if not names:
+    names = [n.strip() for n in str(text).split(",")]
+    if not any(names):
         raise ParameterError("--controllers: expected a comma-separated list of controller names, got an empty list")
+    if not all(names):  # 'pi,,mpc' or 'pi,': a name left out by mistake, not nothing
+        raise ParameterError(f"--controllers: an empty name in {text!r}; expected names separated by single commas")
     for n in names:
         if n not in CONTROLLER_NAMES:
             raise ParameterError(f"--controllers: unknown controller {n!r}; expected names from "
