@@ -9,7 +9,7 @@ import sys
 import numpy as np
 
 from hwpts.commands._args import file_with_suffix, finite_float, grid, non_negative_float, non_negative_int
-from hwpts.errors import ParameterError
+from hwpts.errors import ParameterError, SimulationError
 
 INPUT_COLUMNS = ("time_s", "valve_voltage_v", "pump_speed_rpm")
 """Columns of an --inputs CSV for ``hwpts plant simulate``."""
@@ -121,11 +121,11 @@ def sweep_command(args) -> int:
     check_input_ranges(0.0, pumps, where="--pump-speeds: ")
     result = sweep(PlantParameters.paper(), voltages, pumps)
     write_table(args.out, sweep_columns(result))
-    print(
-        f"wrote {args.out}: {result.points_per_sweep} points per sweep (up, down, average); "
-        f"largest hysteresis gap {np.max(np.abs(result.gap_percent)):.1f} % of full scale",
-        file=sys.stderr if is_stdout(args.out) else sys.stdout,
-    )
+    gap_rpm = float(np.max(np.abs(result.up_rpm - result.down_rpm)))
+    gap = (f"largest hysteresis gap {np.max(np.abs(result.gap_percent)):.1f} % of full scale ({gap_rpm:.1f} r/min)"
+           if result.points_per_sweep > 1 else f"hysteresis gap {gap_rpm:.1f} r/min (one operating point: no full scale)")
+    print(f"wrote {args.out}: {result.points_per_sweep} points per sweep (up, down, average); {gap}",
+          file=sys.stderr if is_stdout(args.out) else sys.stdout)
     return 0
 
 
@@ -150,8 +150,8 @@ def simulate_command(args) -> int:
                 raise DataError(f"missing column(s) {missing}; available columns are {sorted(columns)}")
             dataset, _ = bed.run(columns["time_s"], columns["valve_voltage_v"], columns["pump_speed_rpm"],
                                  seed=args.seed)
-        except DataError as error:
-            raise DataError(f"--inputs {args.inputs!r}: {error}") from None
+        except (DataError, SimulationError) as error:
+            raise type(error)(f"--inputs {args.inputs!r}: {error}") from None
     write_table(args.out, dataset.columns())
     print(f"wrote {args.out}: {dataset.n_samples} samples, {dataset.time[-1] - dataset.time[0]:.2f} s",
           file=sys.stderr if is_stdout(args.out) else sys.stdout)

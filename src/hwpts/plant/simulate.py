@@ -115,9 +115,13 @@ def _integrate(t, h_cmd, wp_cmd, p, z0, rtol, atol, max_step, out, stats):
         t1 = t[k + 1]
         tc = t0
         guard = 0
+        # steps allowed in this interval: a long one (6000 s of constant inputs between two rows)
+        # needs (t1 - t0) / max_step of them, and ran out at 100,000 (steps below 1 ms earn none:
+        # the guard still stops a step size that collapses)
+        limit = 100000 + int(4.0 * (t1 - t0) / max(max_step, 1e-3))
         while tc < t1 - 1e-12 * (1.0 + abs(t1)):
             guard += 1
-            if guard > 100000:
+            if guard > limit:
                 return k
             hh = min(hstep, t1 - tc, max_step)
             # W = I - gamma h J (augmented 6 x 6 Jacobian)
