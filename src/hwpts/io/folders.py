@@ -96,7 +96,8 @@ def staged_folder(path: str | os.PathLike, schema: str):
     try:
         yield stage
     except BaseException:
-        shutil.rmtree(stage, ignore_errors=True)
+        with point_of_no_return():  # removed whole: a second Ctrl-C inside rmtree left the stage behind
+            shutil.rmtree(stage, ignore_errors=True)
         raise
     # the target is moved aside and the stage moved in as one step: a signal in between would
     # leave no folder at `out` (and the next run would delete the one moved aside)
