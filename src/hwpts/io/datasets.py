@@ -158,7 +158,7 @@ def numeric_share(path: str | os.PathLike, column: str) -> float:
     except OSError:
         return 0.0
     rows = [r for r in csv.reader(io.StringIO(text), delimiter=_sniff(p)) if any(c.strip() for c in r)]
-    header = [h.strip() for h in rows[0]] if rows else []
+    header = [h.strip() for h in numbered[0][1]] if rows else []
     if column not in header:
         return 0.0
     j = header.index(column)
@@ -191,10 +191,9 @@ def _read_csv_python(p: Path, delimiter: str = ",", columns=None) -> dict[str, n
         if len(row) > 1 or (row and row[0].strip()):
             numbered.append((line, row))
         line = reader.line_num + 1
-    rows = [r for _, r in numbered]
-    if not rows:
+    if not numbered:
         raise DataError(f"{str(p)!r}: empty file, expected a header row of column names")
-    header = [h.strip() for h in rows[0]]
+    header = [h.strip() for h in numbered[0][1]]
     while header and not header[-1]:  # trailing empty columns (a comma at the end of every row)
         header.pop()
     if header and all(is_number(h) for h in header):
@@ -205,12 +204,13 @@ def _read_csv_python(p: Path, delimiter: str = ",", columns=None) -> dict[str, n
         raise DataError(f"{str(p)!r}: duplicate column name(s) {dup}")
     if any(not h for h in header):
         raise DataError(f"{str(p)!r}: empty column name in the header row")
-    body = rows[1:]
+    body = numbered[1:]
     if not body:
         raise DataError(f"{str(p)!r}: no data rows after the header")
     wanted = [j for j, h in enumerate(header) if columns is None or h in set(columns)]
+    missing = _missing_cells()
     values = np.empty((len(body), len(header)))
-    for k, (i, row) in enumerate(numbered[1:]):
+    for k, (i, row) in enumerate(body):
         while len(row) > len(header) and not row[-1].strip():
             row = row[:-1]
         if len(row) != len(header):
@@ -219,7 +219,7 @@ def _read_csv_python(p: Path, delimiter: str = ",", columns=None) -> dict[str, n
             )
         for j in wanted:
             cell = row[j]
-            if cell.strip() in MISSING:  # as the fast reader: NaN, refused only where the rows are used
+            if cell.strip() in missing:  # as the fast reader: NaN, refused only where the rows are used
                 values[k, j] = np.nan
                 continue
             try:
@@ -230,9 +230,11 @@ def _read_csv_python(p: Path, delimiter: str = ",", columns=None) -> dict[str, n
     return {header[j]: values[:, j].copy() for j in wanted}
 
 
-# the cells pyarrow's CSV reader reads as missing (null), read as NaN by the line-by-line reader too
-MISSING = frozenset(["", "#N/A", "#N/A N/A", "#NA", "-1.#IND", "-1.#QNAN", "-NaN", "-nan", "1.#IND", "1.#QNAN",
-                     "N/A", "NA", "NULL", "NaN", "n/a", "nan", "null"])
+def _missing_cells() -> frozenset:
+    """The cells pyarrow's CSV reader reads as missing (null): NaN in the line-by-line reader too."""
+    import pyarrow.csv as pacsv
+
+    return frozenset(pacsv.ConvertOptions().null_values)
 
 
 def _cells(a: np.ndarray, fmt: str | None) -> list:
@@ -282,8 +284,6 @@ def write_table(path: str | os.PathLike, columns: Mapping[str, np.ndarray]) -> N
     if is_stdout(path):
         import sys
 
-        if sys.stdout is None:  # started with standard output closed (>&-)
-            raise DataError("--out -: standard output is closed; give a file name")
         sys.stdout.write(csv_text(columns))
         sys.stdout.flush()
         return

@@ -209,22 +209,17 @@ def _require(doc, key, kind, where):
 MAX_MODEL_NUMBER = 1e100  # beyond it a parameter or boundary overflows in the first products
 
 
-def _has_bool(value) -> bool:
-    if isinstance(value, bool):
+def _has_leaf(value, kind: type) -> bool:
+    """Whether ``value`` (nested lists) holds a ``kind`` (``bool``, ``str``) anywhere."""
+    if isinstance(value, kind):
         return True
-    return isinstance(value, list) and any(_has_bool(v) for v in value)
-
-
-def _has_text(value) -> bool:
-    if isinstance(value, str):
-        return True
-    return isinstance(value, list) and any(_has_text(v) for v in value)
+    return isinstance(value, list) and any(_has_leaf(v, kind) for v in value)
 
 
 def _numbers(value, shape_desc: str, where: str) -> np.ndarray:
-    if _has_bool(value):
+    if _has_leaf(value, bool):
         raise DataError(f"{where} must be {shape_desc} (JSON numbers), got true/false")
-    if _has_text(value):  # numpy reads "0.5" as 0.5: a JSON number written as text is no number
+    if _has_leaf(value, str):  # numpy reads "0.5" as 0.5: a JSON number written as text is no number
         raise DataError(f"{where} must be {shape_desc} (JSON numbers), got text")
     try:
         arr = np.asarray(value, dtype=float)

@@ -568,7 +568,7 @@ class PWARXSearch(BaseEstimator):
         order_grid = self._order_grid(base, u, yy)
         max_lag = max(self._max_lag(base, o) for o in order_grid)
         splits = self._splits(n, max_lag)
-        for number, (_, test) in enumerate(splits if np.ptp(yy) > 0 else [], start=1):  # (constant: the fit says so)
+        for number, (_, test) in enumerate(splits, start=1):
             if test.size > max_lag and np.ptp(yy[test[max_lag:]]) == 0:
                 raise DataError(f"PWARXSearch: the output is constant over held-out block {number} of {len(splits)} "
                                 f"(samples {test[0]}-{test[-1]}): no fit % can score a model there; give the model "
