@@ -158,7 +158,7 @@ def numeric_share(path: str | os.PathLike, column: str) -> float:
     except OSError:
         return 0.0
     rows = [r for r in csv.reader(io.StringIO(text), delimiter=_sniff(p)) if any(c.strip() for c in r)]
-    header = [h.strip() for h in numbered[0][1]] if rows else []
+    header = [h.strip() for h in rows[0]] if rows else []
     if column not in header:
         return 0.0
     j = header.index(column)
