@@ -24,6 +24,7 @@ __all__ = ["PartitionLearner", "drop_empty_regions", "noise_variance", "confiden
 
 TRIM = 3.0  # outlier threshold (robust std) of the local least squares of learned partitions
 SEPARABLE_C = 1e8  # the classifier's regularisation on labels it can separate exactly (sharpen)
+POOL = 20  # the refinement rounds draw their classifier rows from at most POOL x classifier_rows rows
 
 
 def drop_empty_regions(labels, s):
@@ -235,11 +236,18 @@ class PartitionLearner:
     def _informative(self, mask, logp, rng):
         """At most ``classifier_rows`` rows of ``mask`` for the classifier: the half nearest the
         current boundaries (smallest gap between the two largest class scores) and a random half
-        of the rest. Far-away rows hardly move a near-separable logistic boundary."""
+        of the rest, both out of at most :data:`POOL` x ``classifier_rows`` rows drawn at random.
+        Far-away rows hardly move a near-separable logistic boundary."""
         limit = int(self.classifier_rows)
         idx = np.flatnonzero(mask)
         if idx.size <= limit or logp is None:
             return mask
+        if idx.size > POOL * limit:
+            # the nearest of a random pool: the nearest ``limit / 2`` of a million rows hug the
+            # current boundaries so closely that the refit cannot move them (the zoo's
+            # ``pwarx_random`` with 1e6 samples: one-step fit 90.99 % on three data sets, against
+            # 99.94-99.96 % from a pool, as with 300,000 samples)
+            idx = np.sort(rng.choice(idx, POOL * limit, replace=False))
         top2 = np.sort(logp[idx], axis=1)[:, -2:]
         gap = top2[:, 1] - top2[:, 0]
         order = np.argsort(gap)
