@@ -26,8 +26,12 @@ approximations) have no oracle row: PyPARC is their reference.
 (:data:`VARIANTS`: other instances, orders, numbers of modes, partitions, noise, and modes sharing
 parameters), the systems the default was not tuned on.
 
-``python -m benchmarks zoo [--seeds=N] [--systems=a,b] [--variants] [--no-peers]`` (with ``--variants``,
-``--systems`` names variants)
+``--sizes=20000,100000,1000000``: instead, ``pwarx_random`` itself (the zoo's instance: 6 modes,
+na 2, nb 2) with these numbers of training samples, the zoo's "N from 1e4 to 1e6" (with
+``--seeds=1 --no-peers`` at a million samples: the search takes minutes there, PyPARC far longer).
+
+``python -m benchmarks zoo [--seeds=N] [--systems=a,b] [--variants | --sizes=N,N] [--no-peers]`` (with
+``--variants``, ``--systems`` names variants)
 """
 
 from __future__ import annotations
@@ -252,11 +256,21 @@ def main(argv=None) -> int:
         return 0
     n_seeds = 10
     variants = "--variants" in argv
+    sizes = []
     known = list(VARIANTS) if variants else list(zoo.SYSTEMS)
     systems = known
     for a in argv:
         if a.startswith("--seeds="):
             n_seeds = int(a.split("=", 1)[1])
+        elif a.startswith("--sizes="):
+            try:
+                sizes = [int(v) for v in a.split("=", 1)[1].split(",")]
+            except ValueError:
+                sizes = []
+            if not sizes or min(sizes) < 100:
+                print(f"zoo: --sizes: expected numbers of samples >= 100 separated by commas; got {a.split('=', 1)[1]!r}",
+                      file=sys.stderr)
+                return 2
         elif a.startswith("--systems="):  # with --variants: variant labels
             systems = [s for s in a.split("=", 1)[1].split(",") if s]
             unknown = [s for s in systems if s not in known]
@@ -264,7 +278,9 @@ def main(argv=None) -> int:
                 print(f"zoo: --systems: expected names among {', '.join(known)}; got {', '.join(unknown) or 'none'}",
                       file=sys.stderr)
                 return 2
-    if variants:  # (label, system, generator settings)
+    if sizes:  # (label, system, generator settings)
+        runs = [(f"N={n:,}", "pwarx_random", {"n": n}) for n in sizes]
+    elif variants:
         runs = [(label, "pwarx_random", VARIANTS[label]) for label in systems]
     else:
         runs = [(name, name, None) for name in systems]
