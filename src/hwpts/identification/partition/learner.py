@@ -246,7 +246,7 @@ class PartitionLearner:
             # the nearest of a random pool: the nearest ``limit / 2`` of a million rows hug the
             # current boundaries so closely that the refit cannot move them (the zoo's
             # ``pwarx_random`` with 1e6 samples: one-step fit 90.99 % on three data sets, against
-            # 99.94-99.96 % from a pool, as with 300,000 samples)
+            # 99.94-99.95 % from a pool, as with 300,000 samples)
             idx = np.sort(rng.choice(idx, POOL * limit, replace=False))
         top2 = np.sort(logp[idx], axis=1)[:, -2:]
         gap = top2[:, 1] - top2[:, 0]

@@ -235,9 +235,9 @@ class AlternatingSegmenter(Segmenter):
         best objective so far, the chance that one start succeeds is about ``p = m / r``, and
         ``log(0.01) / log(1 - p)`` starts find the best minimum with 99 % probability; starts run
         until that many were made (at least 3, at most ``AUTO_MAX_RESTARTS``; fewer on 1,000-4,000
-        rows, where each start costs more; above 4,000 rows they run on a subset of 4,000). The default: a fixed 4 left
-        a noise-free two-mode system unrecovered about once in 1,000 random draws (all four starts
-        in one 0.18 minimum, the tenth start at the exact one).
+        rows, where each start costs more; above 4,000 rows they run on a subset of 4,000). The
+        default: a fixed 4 left a noise-free two-mode system unrecovered about once in 1,000
+        random draws (all four starts in one 0.18 minimum, the tenth start at the exact one).
     gamma : float
         Weight of the region-separability term (in units of the residual variance).
     max_iter : int
@@ -269,7 +269,7 @@ class AlternatingSegmenter(Segmenter):
         if auto and self.n_restarts != "auto":
             raise ParameterError(f"alternating: n_restarts must be an int >= 1 or 'auto', got {self.n_restarts!r}")
         budget = AUTO_MAX_RESTARTS if auto else max(1, int(self.n_restarts))
-        if auto and X.shape[0] > 1000 and not mixed:  # large data: fewer starts, each dearer (and each sees more samples)
+        if auto and X.shape[0] > 1000 and not mixed:  # 1,000-4,000 rows: fewer starts, each dearer
             budget = max(AUTO_MIN_RESTARTS, int(AUTO_MAX_RESTARTS * 1000 / X.shape[0]))
         for r in range(budget):
             if auto and r >= AUTO_MIN_RESTARTS and r >= restarts_needed(objectives):
