@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import sys
 from pathlib import Path
 
 from hwpts.text import plain_float, plain_int
@@ -100,8 +101,6 @@ def file_with_suffix(*suffixes: str, stdout: bool = False):
     existing folder; ``-`` (standard output) too when ``stdout``."""
     def check(text: str) -> Path | str:
         if stdout and text == "-":
-            import sys
-
             if sys.stdout is None:  # started with standard output closed (>&-): said before any work
                 raise argparse.ArgumentTypeError("standard output is closed; give a file name")
             return text

@@ -195,14 +195,12 @@ def study_command(args) -> int:
     if args.scenario not in SCENARIOS:
         raise ParameterError(f"--scenario: unknown scenario {args.scenario!r}; expected one of {', '.join(SCENARIOS)}")
     names = parse_names(args.controllers)
-    if "pi" not in names:
-        # the targets hold a controller to 30 % below the PI baseline on the same run: without it
-        # that target was dropped in silence (the same controller met the targets or not as pi was
-        # listed)
+    # the targets hold a controller to 30 % below the PI baseline on the same run: without it that
+    # target was dropped in silence (the same controller met the targets or not as pi was listed);
+    # the addition is said once the study has run (before, it made a second line beside an error)
+    added_pi = "pi" not in names
+    if added_pi:
         names = ["pi", *names]
-        added_pi = True  # said once the study has run (before, it made a second line beside an error)
-    else:
-        added_pi = False
     check_replaceable(args.out, STUDY_SCHEMA)
     start = time.perf_counter()
     _, doc, sample_time, half_width, source = _model_bank(args)

@@ -280,17 +280,13 @@ class AlternatingSegmenter(Segmenter):
                 init = kmeans_labels(np.column_stack([Z, ys]), s, rng, n_init=1)
             else:
                 init = random_parameter_labels(Phi, ys, s, rng)
-            best = self._start(Phi, ys, Z, init, s, r, objectives, best)
+            for mult in tuple(float(a) for a in self.anneal):
+                init, _, _ = alternate(Phi, ys, Z, init, s, self.gamma * mult, ANNEAL_ITER)
+            labels, obj, it = alternate(Phi, ys, Z, init, s, self.gamma, self.max_iter)
+            objectives.append(obj)
+            if best is None or obj < best[1]:
+                best = (labels, obj, it, r)
         return (*best, objectives)
-
-    def _start(self, Phi, ys, Z, init, s, r, objectives, best):
-        """Alternate from ``init`` (after the continuation stages, if any); the better of ``best``
-        and this start, whose objective is appended to ``objectives``."""
-        for mult in tuple(float(a) for a in self.anneal):
-            init, _, _ = alternate(Phi, ys, Z, init, s, self.gamma * mult, ANNEAL_ITER)
-        labels, obj, it = alternate(Phi, ys, Z, init, s, self.gamma, self.max_iter)
-        objectives.append(obj)
-        return (labels, obj, it, r) if best is None or obj < best[1] else best
 
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
         """Labels from alternating assignment and least squares with restarts (see the module docstring)."""
