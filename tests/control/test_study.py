@@ -133,3 +133,77 @@ def test_ctrl_c_at_the_terminal_stops_a_study_in_one_line(tmp_path, paper_model_
     assert "Traceback" not in text and "WARNING" not in text, text
     assert text.strip().splitlines()[-1] == "hwpts: interrupted"
     assert not (tmp_path / "study").exists()
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc to see the workers start")
+@pytest.mark.parametrize("name", ["SIGINT", "SIGTERM"])
+def test_a_signal_while_the_local_cluster_starts_is_not_lost(tmp_path, paper_model_file, name):
+    """A Ctrl-C in the second or two the cluster takes to start (the workers just spawned) was
+    ignored: the study ran on. It now ends the run as any interrupt, the workers silent, and
+    nothing after hwpts's line (a cluster stopped half-way left semaphores that multiprocessing's
+    resource tracker reported as leaked); the same for a SIGTERM to the process group."""
+    import os
+    import signal
+
+    proc = subprocess.Popen([sys.executable, "-m", "hwpts", "control", "study", "--plants", "50", "--seeds", "2",
+                             "--duration", "60", "--workers", "2", "--model", str(paper_model_file),
+                             "--out", str(tmp_path / "study")],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True, cwd=tmp_path)
+    try:
+        deadline = time.monotonic() + 120
+        while not _spawned_children(proc.pid) and time.monotonic() < deadline and proc.poll() is None:
+            time.sleep(0.01)
+        assert _spawned_children(proc.pid), "the local cluster's workers never started"
+        os.killpg(proc.pid, getattr(signal, name))  # the workers are importing Python
+        _, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+    text = err.decode()
+    assert proc.returncode == 130, text
+    assert "Traceback" not in text and "KeyboardInterrupt" not in text and "WARNING" not in text, text
+    assert text.strip().splitlines()[-1] == "hwpts: interrupted", text
+    assert not (tmp_path / "study").exists()
+
+
+class _FakeCluster:
+    def __init__(self, during=None, **kwargs):
+        self.closed = False
+        if during is not None:
+            during()
+
+    def close(self):
+        self.closed = True
+
+
+@pytest.mark.skipif(not hasattr(__import__("signal"), "pthread_sigmask"), reason="POSIX signal masks")
+def test_the_local_cluster_start_restores_the_handlers_and_the_mask():
+    import signal
+
+    from hwpts.control.study import _local_cluster
+
+    def handler(signum, frame):
+        raise KeyboardInterrupt
+
+    before = {sig: signal.signal(sig, handler) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        cluster = _local_cluster(_FakeCluster, 2)
+        assert not cluster.closed
+        assert signal.getsignal(signal.SIGINT) is handler and signal.getsignal(signal.SIGTERM) is handler
+        assert signal.SIGINT not in signal.pthread_sigmask(signal.SIG_BLOCK, [])
+        made = []
+
+        def start(**kwargs):  # the signal arrives while the cluster starts: held, then delivered
+            made.append(_FakeCluster(during=lambda: signal.raise_signal(signal.SIGTERM)))
+            return made[-1]
+
+        with pytest.raises(KeyboardInterrupt):
+            _local_cluster(start, 2)
+        assert made[0].closed
+        assert signal.getsignal(signal.SIGTERM) is handler
+        assert signal.SIGINT not in signal.pthread_sigmask(signal.SIG_BLOCK, [])
+    finally:
+        for sig, old in before.items():
+            signal.signal(sig, old)

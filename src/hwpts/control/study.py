@@ -166,25 +166,76 @@ def _connect(Client, scheduler: str):
 def _local_cluster(LocalCluster, n_workers: int | None):
     """A local Dask cluster that leaves Ctrl-C to hwpts. A Ctrl-C at the terminal reaches the
     whole process group: each worker process printed its own traceback and the nanny its warnings
-    about cancelled tasks and killed workers. The workers start with SIGINT ignored (a disposition
-    an executed process inherits, and which Python and asyncio then leave alone), so only hwpts
-    sees it and closes the cluster; the cluster's own log stays at errors. A Ctrl-C in the second
-    or two the cluster takes to start is ignored (press it again); SIGTERM is not affected."""
+    about cancelled tasks and killed workers. SIGINT is blocked while the cluster starts: the
+    workers inherit the blocked mask through fork and exec (and Python leaves it alone), as do
+    the cluster's threads, which spawn any later worker, so only hwpts sees a Ctrl-C; the
+    cluster's own log stays at errors. A Ctrl-C or SIGTERM in the second or two the cluster takes
+    to start is held until it has started (stopped half-way, the cluster left its workers'
+    semaphores to multiprocessing's resource tracker, which reported them as leaked after hwpts's
+    last line); the cluster is then closed and the signal delivered to the handler it had."""
     import logging
     import signal
     import threading
+    from multiprocessing import resource_tracker
 
     def start():
         return LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
                             dashboard_address=":0", silence_logs=logging.ERROR)
 
-    if threading.current_thread() is not threading.main_thread():  # only the main thread sets handlers
+    held = (signal.SIGINT, signal.SIGTERM)
+    previous = {sig: signal.getsignal(sig) for sig in held}
+    if (threading.current_thread() is not threading.main_thread() or not hasattr(signal, "pthread_sigmask")
+            or any(handler is None for handler in previous.values())):  # handlers not ours to move
         return start()
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    # multiprocessing's resource tracker, started from the cluster's event-loop thread, would
+    # unblock SIGINT there (it blocks and unblocks it around its own spawn): started first here
+    resource_tracker.ensure_running()
+    caught: list = []
+    sigint = {signal.SIGINT}
+
+    def deliver():  # the handlers back, then what they missed: hwpts's raise KeyboardInterrupt
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+        pending = signal.SIGINT in signal.sigpending()
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, sigint)  # a pending SIGINT reaches its handler here
+        for sig in dict.fromkeys(caught):
+            if previous[sig] is not signal.SIG_IGN and not (pending and sig == signal.SIGINT):
+                signal.raise_signal(sig)
+
+    for sig in held:
+        signal.signal(sig, lambda signum, frame: caught.append(signum))
+    signal.pthread_sigmask(signal.SIG_BLOCK, sigint)
     try:
-        return start()
-    finally:
-        signal.signal(signal.SIGINT, previous)
+        cluster = start()
+    except BaseException:  # a SIGTERM to the process group stops the starting workers too
+        deliver()
+        raise
+    if signal.SIGINT in signal.sigpending():  # held by the mask: delivered by deliver()'s unblocking
+        caught.append(signal.SIGINT)
+    stopping = any(previous[sig] is not signal.SIG_IGN for sig in caught)
+    if stopping:
+        _close(cluster)
+        cluster = None
+    try:
+        deliver()
+    except BaseException:
+        if cluster is not None:
+            _close(cluster)
+        raise
+    if stopping:  # handlers that recorded the signal without raising
+        raise KeyboardInterrupt
+    return cluster
+
+
+def _close(cluster) -> None:
+    """Close a cluster the run will not use, and collect it now: its workers' queues hold
+    semaphores that multiprocessing's resource tracker, finding them at the exit, reports as
+    leaked (a line after hwpts's own)."""
+    import gc
+
+    cluster.close()
+    del cluster
+    gc.collect()
 
 
 def run_study(model_doc: dict, model_sample_time: float, half_width: float, n_plants: int, n_seeds: int,
