@@ -361,6 +361,12 @@ def _orders_summary(search):
     else:
         why = (f"the orders of the best ARX models were tried (held-out one-step fit {arx:.1f} %; a "
                f"nearest-neighbour predictor's {nn:.1f} % was not {NEIGHBOUR_GATE:g} points better)")
+    simplest = info.get("parsimonious")
+    if simplest:
+        short = {"output_order": "na", "input_order": "nb", "input_delay": "nk"}
+        said = ", ".join(f"{short.get(k, k)} {v}" for k, v in simplest.items())
+        why += (f"; {said} was tried second: the fewest parameters among the ARX models the best one does "
+                f"not beat by the choice's rule")
     return {**info, "why": why}
 
 
