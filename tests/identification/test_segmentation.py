@@ -21,7 +21,7 @@ from hwpts.identification.synthetic import make_system
 
 def test_registry_names_and_unknown_name_lists_them():
     assert set(SEGMENTATION_METHODS) == {"average", "zscore", "kmeans", "hyperplane", "clustering",
-                                         "alternating", "threshold", "switched"}
+                                         "alternating", "threshold", "threshold-alternating", "switched"}
     with pytest.raises(ParameterError, match=r"unknown segmentation 'nope'; valid methods are \['alternating'"):
         make_segmenter("nope")
 
@@ -385,3 +385,28 @@ def test_boundary_refinement_moves_a_misplaced_boundary_on_a_million_rows():
     start = (X[:, 0] + 0.5 * X[:, 1] > 0.15).astype(np.int64)  # 5 % of the rows on the wrong side
     labels, _, _ = PartitionLearner(random_state=0).learn(X, y, start, 2)
     assert np.sum(labels != true) <= 100
+
+
+def test_threshold_alternating_turns_the_split_into_oblique_boundaries():
+    """A tank that empties and overflows (``y(k) = min(10, max(0, y(k-1) + 0.2 u(k-1)))``): the
+    least-squares split on ``y(k-1)`` finds the three modes, but its cuts perpendicular to that
+    column make the full and empty tank absorbing states in free run; started from that split, the
+    alternation and the learned partition put the boundaries on ``y(k-1) + 0.2 u(k-1)``."""
+    from .test_order_ranking import tank
+
+    u, y, uv, yv = tank(3000, 0)
+    split = PWARX(1, 1, 1, n_regions=3, segmentation="threshold", random_state=0).fit(u, y)
+    refined = PWARX(1, 1, 1, n_regions=3, segmentation="threshold-alternating", random_state=0).fit(u, y)
+    assert split.simulate(uv, initial_output=yv[:1]).score(yv) < 0  # stuck full or empty
+    assert refined.simulate(uv, initial_output=yv[:1]).score(yv) > 95
+    info = refined.segmentation_info_
+    assert info["method"] == "threshold-alternating" and info["column"] == "y(k-1)" and len(info["thresholds"]) == 2
+    # the filling mode's parameters: y(k-1) + 0.2 u(k-1)
+    filling = refined.theta_[np.argmax(np.abs(refined.theta_[:, 0]))]
+    np.testing.assert_allclose(filling, [1.0, 0.2, 0.0], atol=0.02)
+    # the boundaries are oblique (the split's are on y(k-1) alone): each normal weighs the input
+    # a fifth to a half of the output (0.2 for the true ones)
+    for H in refined.partition_.H:
+        assert np.all((np.abs(H[:, 1]) > 0.1 * np.abs(H[:, 0])) & (np.abs(H[:, 1]) < 0.6 * np.abs(H[:, 0])))
+    for H in split.partition_.H:
+        assert np.all(H[:, 1] == 0)

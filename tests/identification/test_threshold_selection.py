@@ -610,3 +610,29 @@ def test_threshold_costs_are_exact_on_collinear_lags():
             assert m.segmentation_info_["sse"] == pytest.approx(direct, rel=1e-4)
         sse[s] = direct
     assert sse[1] >= sse[2] >= sse[3]
+
+
+def test_a_split_worse_than_no_split_brings_in_its_oblique_refinement():
+    """Where the ``threshold`` model's free run scores below the single ARX model's (a cut across
+    the true boundaries: on a tank that empties and overflows the cut on y(k-1) makes the full
+    and empty tank absorbing states), ``threshold-alternating`` races from that count on and wins;
+    where the split works (a SETAR system switching on y(k-1)) it is never tried."""
+    from .test_order_ranking import tank
+
+    u, y, uv, yv = tank(3000, 0)
+    search = PWARXSearch(PWARX(1, 1, 1, random_state=0), try_polish=False, shared_modes=False,
+                         output_powers=None).fit(u, y)
+    rows = search.cv_results_
+    arx = next(r for r in rows if r["params"]["segmentation"] == "average")
+    split = next(r for r in rows if r["params"]["segmentation"] == "threshold" and r["params"]["n_regions"] == 2)
+    assert np.mean(split["split_fits_percent"]) < np.mean(arx["split_fits_percent"][:len(split["split_fits_percent"])])
+    refined = [r for r in rows if r["params"]["segmentation"] == "threshold-alternating"]
+    assert refined and min(r["params"]["n_regions"] for r in refined) == 2
+    assert search.best_params_["segmentation"] == "threshold-alternating"
+    assert search.best_estimator_.simulate(uv, initial_output=yv[:1]).score(yv) > 95
+
+    u, y = setar(3000, 0)
+    search = PWARXSearch(PWARX(1, 1, 1, random_state=0), try_polish=False, shared_modes=False,
+                         output_powers=None).fit(u, y)
+    assert not [r for r in search.cv_results_ if r["params"]["segmentation"] == "threshold-alternating"]
+    assert search.best_params_["segmentation"] == "threshold"

@@ -838,7 +838,7 @@ def _common_data_args(parser):
 # the registry's names, written out so that `hwpts --help` does not import the library (a test
 # checks that they match hwpts.identification.segmentation.SEGMENTATION_METHODS)
 SEGMENTATION_NAMES = ("alternating", "average", "clustering", "hyperplane", "kmeans", "switched", "threshold",
-                      "zscore")
+                      "threshold-alternating", "zscore")
 
 
 def _mapping_args(parser):
@@ -886,7 +886,8 @@ def register(subparsers):
                    help="input delay, 0 uses u(k) (default: chosen on the data, 0-1 or an estimated dead time "
                         "and one less; 1 when --na and --nb are given)")
     p.add_argument("--segmentation", choices=["auto", *SEGMENTATION_NAMES], default=None,
-                   help="segmentation method (default auto: chosen on the data among threshold and alternating; "
+                   help="segmentation method (default auto: chosen on the data among threshold, alternating "
+                        "(and threshold-alternating where a threshold split's free run is worse than none); "
                         "hyperplane when --hyperplane is given)")
     p.add_argument("--regions", default="auto", metavar="S",
                    help="number of regions (default auto: grown while the held-out fit improves)")

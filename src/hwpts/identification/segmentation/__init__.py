@@ -9,6 +9,8 @@ The registry's keys are the names the CLI accepts (``hwpts identify --segmentati
 - ``clustering``: Ferrari-Trecate et al. (2003) clustering of local parameter vectors;
 - ``alternating``: alternating assignment / least squares with a separability term (k-LinReg, PARC);
 - ``threshold``: thresholds on one regressor column, e.g. ``y(k-1)``, by least squares (SETAR/TARX);
+- ``threshold-alternating``: that threshold split as the start of the alternation, the partition
+  then learned (oblique boundaries from contiguous modes);
 - ``switched``: ``n_regions`` distinct local models (switched regression), then the regions each covers
   (modes that share parameters on disjoint regions);
 
@@ -27,6 +29,7 @@ from hwpts.identification.segmentation.hyperplane import HyperplaneSegmenter
 from hwpts.identification.segmentation.kmeans import KMeansSegmenter
 from hwpts.identification.segmentation.switched import SwitchedSegmenter
 from hwpts.identification.segmentation.threshold import ThresholdSegmenter
+from hwpts.identification.segmentation.threshold_alternating import ThresholdAlternatingSegmenter
 from hwpts.identification.segmentation.zscore import ZScoreSegmenter
 
 SEGMENTATION_METHODS: dict[str, type[Segmenter]] = {
@@ -37,6 +40,7 @@ SEGMENTATION_METHODS: dict[str, type[Segmenter]] = {
     "clustering": ClusteringSegmenter,
     "alternating": AlternatingSegmenter,
     "threshold": ThresholdSegmenter,
+    "threshold-alternating": ThresholdAlternatingSegmenter,
     "switched": SwitchedSegmenter,
 }
 
