@@ -636,3 +636,14 @@ def test_a_split_worse_than_no_split_brings_in_its_oblique_refinement():
                          output_powers=None).fit(u, y)
     assert not [r for r in search.cv_results_ if r["params"]["segmentation"] == "threshold-alternating"]
     assert search.best_params_["segmentation"] == "threshold"
+
+
+def test_a_search_told_its_methods_is_not_given_the_refinement():
+    """``methods=("threshold",)`` (``hwpts identify --segmentation threshold``) races threshold alone,
+    even where its split's free run is worse than none."""
+    from .test_order_ranking import tank
+
+    u, y, _, _ = tank(3000, 0)
+    search = PWARXSearch(PWARX(1, 1, 1, random_state=0), methods=("threshold",), max_regions=3,
+                         try_polish=False, shared_modes=False, output_powers=None).fit(u, y)
+    assert {r["params"]["segmentation"] for r in search.cv_results_} == {"average", "threshold"}

@@ -655,6 +655,9 @@ class PWARXSearch(BaseEstimator):
             self._decide_scoring(table)
         methods = self._methods()
         survivors = list(methods)
+        # the refinement of a failed split joins the race only where both methods it combines are
+        # raced and it is not raced already (``methods=("threshold",)`` asks for threshold alone)
+        refine = {"threshold", "alternating"} <= {m for m in methods if isinstance(m, str)} and REFINED not in methods
         for number, orders in enumerate(keep):
             best, best_one = self._bests(table, orders)
             top = min(self._room(base, orders, u, splits),
@@ -683,7 +686,7 @@ class PWARXSearch(BaseEstimator):
                     leader = None
                 overall = -np.inf if leader is None else self._score(leader)
                 rows = self._run(base, cands, u, y, splits, "regions", bar, overall, leader)
-                if REFINED not in active and REFINED not in methods and self._split_hurts(rows, table, orders):
+                if refine and REFINED not in active and self._split_hurts(rows, table, orders):
                     # the split's free run is worse than no split: its cut lies across the true
                     # boundary, so the split refined into oblique boundaries races from here on
                     rows = rows + self._run(base, [{**orders, "segmentation": REFINED, "n_regions": s,
