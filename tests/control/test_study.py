@@ -207,3 +207,36 @@ def test_the_local_cluster_start_restores_the_handlers_and_the_mask():
     finally:
         for sig, old in before.items():
             signal.signal(sig, old)
+
+
+class _StuckCluster(_FakeCluster):
+    def close(self):
+        raise RuntimeError("close timed out")
+
+
+@pytest.mark.skipif(not hasattr(__import__("signal"), "pthread_sigmask"), reason="POSIX signal masks")
+def test_the_handlers_and_the_mask_come_back_whatever_fails():
+    """A cluster whose close fails after a held signal, and a caller that had SIGINT blocked: the
+    handlers and the caller's mask come back (a failed close left Ctrl-C disabled)."""
+    import signal
+
+    from hwpts.control.study import _local_cluster
+
+    def handler(signum, frame):
+        raise KeyboardInterrupt
+
+    before = {sig: signal.signal(sig, handler) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        with pytest.raises((KeyboardInterrupt, RuntimeError)):
+            _local_cluster(lambda **kw: _StuckCluster(during=lambda: signal.raise_signal(signal.SIGTERM)), 2)
+        assert signal.getsignal(signal.SIGINT) is handler and signal.getsignal(signal.SIGTERM) is handler
+        assert signal.SIGINT not in signal.pthread_sigmask(signal.SIG_BLOCK, [])
+        signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})  # the caller's own block is kept
+        try:
+            assert not _local_cluster(_FakeCluster, 2).closed
+            assert signal.SIGINT in signal.pthread_sigmask(signal.SIG_BLOCK, [])
+        finally:
+            signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+    finally:
+        for sig, old in before.items():
+            signal.signal(sig, old)

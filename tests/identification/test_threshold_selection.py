@@ -647,3 +647,25 @@ def test_a_search_told_its_methods_is_not_given_the_refinement():
     search = PWARXSearch(PWARX(1, 1, 1, random_state=0), methods=("threshold",), max_regions=3,
                          try_polish=False, shared_modes=False, output_powers=None).fit(u, y)
     assert {r["params"]["segmentation"] for r in search.cv_results_} == {"average", "threshold"}
+
+
+def test_a_refinement_dropped_from_the_race_is_not_raced_again(monkeypatch):
+    """Once raced (the split's free run worse than none) the refinement is dropped as any method
+    that trails ``patience`` counts in a row, and not brought back at the next count (it was: it
+    ran at every count to the cap). Made-up scores: the split 40 % free run against the ARX
+    model's 50 %, alternating 60 + s %, the refinement 20 %."""
+    from hwpts.identification.selection import search as S
+
+    def scored(estimator, params, u, y, splits, prune_below=-np.inf, names=None, output_name=None, leader=None,
+               one_step=False, best_row=None):
+        s = params.get("n_regions", 1)
+        free, one = {"average": (50.0, 80.0), "threshold": (40.0, 90.0 + s / 2), "alternating": (60.0 + s, 90.0 + s / 2),
+                     S.REFINED: (20.0, 70.0)}[params["segmentation"]]
+        return made_up_row(params, splits, free, one)
+
+    monkeypatch.setattr(S, "_evaluate", scored)
+    u, y = setar(3000, 0)
+    search = PWARXSearch(PWARX(1, 1, 1, random_state=0), try_polish=False, shared_modes=False,
+                         output_powers=None).fit(u, y)
+    counts = [r["params"]["n_regions"] for r in search.cv_results_ if r["params"]["segmentation"] == S.REFINED]
+    assert counts == [2, 3]  # from the first count on, dropped after trailing twice

@@ -173,6 +173,7 @@ def _local_cluster(LocalCluster, n_workers: int | None):
     to start is held until it has started (stopped half-way, the cluster left its workers'
     semaphores to multiprocessing's resource tracker, which reported them as leaked after hwpts's
     last line); the cluster is then closed and the signal delivered to the handler it had."""
+    import gc
     import logging
     import signal
     import threading
@@ -191,51 +192,54 @@ def _local_cluster(LocalCluster, n_workers: int | None):
     # unblock SIGINT there (it blocks and unblocks it around its own spawn): started first here
     resource_tracker.ensure_running()
     caught: list = []
+    held_mask = set(held)
     sigint = {signal.SIGINT}
 
-    def deliver():  # the handlers back, then what they missed: hwpts's raise KeyboardInterrupt
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
-        pending = signal.SIGINT in signal.sigpending()
-        signal.pthread_sigmask(signal.SIG_UNBLOCK, sigint)  # a pending SIGINT reaches its handler here
+    def deliver(pending: bool):
+        """The handlers and the mask as they were, then the signals recorded meanwhile to their
+        own handlers (hwpts's raise KeyboardInterrupt); a SIGINT held by the mask (``pending``)
+        reaches its handler when the mask goes back."""
+        signal.pthread_sigmask(signal.SIG_BLOCK, held_mask)  # none delivered while the handlers go back
+        try:
+            for sig, handler in previous.items():
+                signal.signal(sig, handler)
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old_mask)
         for sig in dict.fromkeys(caught):
             if previous[sig] is not signal.SIG_IGN and not (pending and sig == signal.SIGINT):
                 signal.raise_signal(sig)
 
     for sig in held:
         signal.signal(sig, lambda signum, frame: caught.append(signum))
-    signal.pthread_sigmask(signal.SIG_BLOCK, sigint)
+    old_mask = signal.pthread_sigmask(signal.SIG_BLOCK, sigint)
     try:
         cluster = start()
     except BaseException:  # a SIGTERM to the process group stops the starting workers too
-        deliver()
+        deliver(signal.SIGINT in signal.sigpending() and signal.SIGINT not in old_mask)
         raise
-    if signal.SIGINT in signal.sigpending():  # held by the mask: delivered by deliver()'s unblocking
+    pending = signal.SIGINT in signal.sigpending() and signal.SIGINT not in old_mask  # a caller's own is its own
+    if pending:
         caught.append(signal.SIGINT)
     stopping = any(previous[sig] is not signal.SIG_IGN for sig in caught)
-    if stopping:
-        _close(cluster)
-        cluster = None
     try:
-        deliver()
-    except BaseException:
-        if cluster is not None:
-            _close(cluster)
-        raise
+        if stopping:
+            # closed and collected now: its workers' queues hold semaphores that multiprocessing's
+            # resource tracker, finding them at the exit, reports as leaked (a line after hwpts's)
+            try:
+                cluster.close()
+            finally:
+                cluster = None
+                gc.collect()
+    finally:
+        try:
+            deliver(pending)
+        except BaseException:
+            if cluster is not None:
+                cluster.close()
+            raise
     if stopping:  # handlers that recorded the signal without raising
         raise KeyboardInterrupt
     return cluster
-
-
-def _close(cluster) -> None:
-    """Close a cluster the run will not use, and collect it now: its workers' queues hold
-    semaphores that multiprocessing's resource tracker, finding them at the exit, reports as
-    leaked (a line after hwpts's own)."""
-    import gc
-
-    cluster.close()
-    del cluster
-    gc.collect()
 
 
 def run_study(model_doc: dict, model_sample_time: float, half_width: float, n_plants: int, n_seeds: int,

@@ -657,7 +657,8 @@ class PWARXSearch(BaseEstimator):
         survivors = list(methods)
         # the refinement of a failed split joins the race only where both methods it combines are
         # raced and it is not raced already (``methods=("threshold",)`` asks for threshold alone)
-        refine = {"threshold", "alternating"} <= {m for m in methods if isinstance(m, str)} and REFINED not in methods
+        names = {getattr(m, "name", m) for m in methods}  # a segmenter instance by its method's name
+        refine = {"threshold", "alternating"} <= names and REFINED not in names
         for number, orders in enumerate(keep):
             best, best_one = self._bests(table, orders)
             top = min(self._room(base, orders, u, splits),
@@ -669,6 +670,7 @@ class PWARXSearch(BaseEstimator):
             # and third orders, each pruned after one block, 0.45 s of a 2.5 s search)
             active = list(methods) if number == 0 else list(survivors)
             behind = dict.fromkeys([*methods, REFINED], 0)
+            refined = False  # raced from its first count on, once an order (then dropped as any method)
             for s in range(2, max(top, 1) + 1):
                 cands = [{**orders, "segmentation": m, "n_regions": s,
                           "segmentation_params": METHOD_PARAMS.get(m)} for m in active]
@@ -686,7 +688,8 @@ class PWARXSearch(BaseEstimator):
                     leader = None
                 overall = -np.inf if leader is None else self._score(leader)
                 rows = self._run(base, cands, u, y, splits, "regions", bar, overall, leader)
-                if refine and REFINED not in active and self._split_hurts(rows, table, orders):
+                if refine and not refined and REFINED not in active and self._split_hurts(rows, table, orders):
+                    refined = True
                     # the split's free run is worse than no split: its cut lies across the true
                     # boundary, so the split refined into oblique boundaries races from here on
                     rows = rows + self._run(base, [{**orders, "segmentation": REFINED, "n_regions": s,
