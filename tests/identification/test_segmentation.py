@@ -410,3 +410,15 @@ def test_threshold_alternating_turns_the_split_into_oblique_boundaries():
         assert np.all((np.abs(H[:, 1]) > 0.1 * np.abs(H[:, 0])) & (np.abs(H[:, 1]) < 0.6 * np.abs(H[:, 0])))
     for H in split.partition_.H:
         assert np.all(H[:, 1] == 0)
+
+
+def test_threshold_alternating_names_itself_in_its_errors():
+    rng = np.random.default_rng(0)
+    u = rng.uniform(-1, 1, 500)
+    y = 0.1 * np.cumsum(u)
+    with pytest.raises(ParameterError, match=r"^threshold-alternating: 3 regions cannot each hold min_share=0.5"):
+        PWARX(1, 1, 1, n_regions=3, segmentation="threshold-alternating",
+              segmentation_params={"min_share": 0.5}).fit(u, y)
+    with pytest.raises(ParameterError, match=r"^threshold-alternating: max_iter"):
+        PWARX(1, 1, 1, n_regions=3, segmentation="threshold-alternating",
+              segmentation_params={"max_iter": 0}).fit(u, y)

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from hwpts.errors import IdentificationError, ParameterError
 from hwpts.identification.segmentation.alternating import alternate
 from hwpts.identification.segmentation.base import SegmentationResult, Segmenter, standardize
 from hwpts.identification.segmentation.threshold import ThresholdSegmenter
@@ -58,8 +59,14 @@ class ThresholdAlternatingSegmenter(Segmenter):
         """The threshold split's labels, alternated to a local minimum; no fixed partition."""
         check_number(self.gamma, "gamma", owner="threshold-alternating: ")
         check_count(self.max_iter, "max_iter", 1, "threshold-alternating: ")
-        split = ThresholdSegmenter(column=self.column, n_grid=self.n_grid, min_share=self.min_share).segment(
-            X, y, n_regions, structure, rng, columns=columns)
+        try:
+            split = ThresholdSegmenter(column=self.column, n_grid=self.n_grid, min_share=self.min_share).segment(
+                X, y, n_regions, structure, rng, columns=columns)
+        except (ParameterError, IdentificationError) as error:  # said as this method's
+            message = str(error)
+            if message.startswith("threshold:"):
+                message = "threshold-alternating:" + message[len("threshold:"):]
+            raise type(error)(message) from None
         s = split.n_regions
         info = {"column": split.info.get("column"), "thresholds": split.info.get("thresholds", [])}
         if s == 1:
