@@ -104,32 +104,41 @@ def _spawned_children(pid: int) -> list[int]:
     return found
 
 
-@pytest.mark.slow
-@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc to see the workers start")
-def test_ctrl_c_at_the_terminal_stops_a_study_in_one_line(tmp_path, paper_model_file):
-    """A terminal's Ctrl-C reaches the whole process group, Dask's worker processes included: they
-    leave it to hwpts (no traceback from any of them), and the run ends as any interrupted run."""
+def _signal_a_study(tmp_path, model_file, sig, workers_seen, settle):
+    """Run ``hwpts control study`` on a local cluster in its own process group, send ``sig`` to
+    the group once ``workers_seen`` worker processes were spawned and ``settle`` seconds passed;
+    the exit status and standard error."""
     import os
     import signal
 
     proc = subprocess.Popen([sys.executable, "-m", "hwpts", "control", "study", "--plants", "50", "--seeds", "2",
-                             "--duration", "60", "--workers", "2", "--model", str(paper_model_file),
+                             "--duration", "60", "--workers", "2", "--model", str(model_file),
                              "--out", str(tmp_path / "study")],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True, cwd=tmp_path)
     try:
         deadline = time.monotonic() + 120
-        while len(_spawned_children(proc.pid)) < 2 and time.monotonic() < deadline and proc.poll() is None:
-            time.sleep(0.2)
-        assert len(_spawned_children(proc.pid)) == 2, "the local cluster's workers never started"
-        time.sleep(3)  # the workers are running tasks
-        os.killpg(proc.pid, signal.SIGINT)
+        while len(_spawned_children(proc.pid)) < workers_seen and time.monotonic() < deadline and proc.poll() is None:
+            time.sleep(0.01)
+        assert len(_spawned_children(proc.pid)) >= workers_seen, "the local cluster's workers never started"
+        time.sleep(settle)
+        os.killpg(proc.pid, sig)
         _, err = proc.communicate(timeout=60)
     finally:
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)
             proc.wait()
-    text = err.decode()
-    assert proc.returncode == 130
+    return proc.returncode, err.decode()
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc to see the workers start")
+def test_ctrl_c_at_the_terminal_stops_a_study_in_one_line(tmp_path, paper_model_file):
+    """A terminal's Ctrl-C reaches the whole process group, Dask's worker processes included: they
+    leave it to hwpts (no traceback from any of them), and the run ends as any interrupted run."""
+    import signal
+
+    status, text = _signal_a_study(tmp_path, paper_model_file, signal.SIGINT, 2, 3)  # the workers run tasks
+    assert status == 130
     assert "Traceback" not in text and "WARNING" not in text, text
     assert text.strip().splitlines()[-1] == "hwpts: interrupted"
     assert not (tmp_path / "study").exists()
@@ -143,26 +152,10 @@ def test_a_signal_while_the_local_cluster_starts_is_not_lost(tmp_path, paper_mod
     ignored: the study ran on. It now ends the run as any interrupt, the workers silent, and
     nothing after hwpts's line (a cluster stopped half-way left semaphores that multiprocessing's
     resource tracker reported as leaked); the same for a SIGTERM to the process group."""
-    import os
     import signal
 
-    proc = subprocess.Popen([sys.executable, "-m", "hwpts", "control", "study", "--plants", "50", "--seeds", "2",
-                             "--duration", "60", "--workers", "2", "--model", str(paper_model_file),
-                             "--out", str(tmp_path / "study")],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True, cwd=tmp_path)
-    try:
-        deadline = time.monotonic() + 120
-        while not _spawned_children(proc.pid) and time.monotonic() < deadline and proc.poll() is None:
-            time.sleep(0.01)
-        assert _spawned_children(proc.pid), "the local cluster's workers never started"
-        os.killpg(proc.pid, getattr(signal, name))  # the workers are importing Python
-        _, err = proc.communicate(timeout=60)
-    finally:
-        if proc.poll() is None:
-            os.killpg(proc.pid, signal.SIGKILL)
-            proc.wait()
-    text = err.decode()
-    assert proc.returncode == 130, text
+    status, text = _signal_a_study(tmp_path, paper_model_file, getattr(signal, name), 1, 0)  # workers importing
+    assert status == 130, text
     assert "Traceback" not in text and "KeyboardInterrupt" not in text and "WARNING" not in text, text
     assert text.strip().splitlines()[-1] == "hwpts: interrupted", text
     assert not (tmp_path / "study").exists()
