@@ -21,12 +21,11 @@ the search's time and choice.
 
 from __future__ import annotations
 
-import time
 import warnings
 
 import numpy as np
 
-from benchmarks.bench_unseen import cell, chosen_label, seeds_and_systems
+from benchmarks.bench_unseen import cell, chosen_label, free_fit, seeds_and_systems, three_fits
 
 NOISE = 0.03  # noise standard deviation, as a share of the noise-free output's
 SIZES = (300, 3000)
@@ -102,13 +101,7 @@ def data(name, seed, n):
     return (u, simulate(name, u, e)), (uv, simulate(name, uv))
 
 
-def _free_fit(model, uv, yv):
-    return model.simulate(uv, initial_output=yv[:10]).score(yv)
-
-
 def main(argv=None) -> int:
-    from hwpts.identification import PWARX, PWARXSearch
-
     parsed = seeds_and_systems(list(argv or []), SYSTEMS, "textbook")
     if parsed is None:
         return 2
@@ -125,17 +118,12 @@ def main(argv=None) -> int:
             chosen, times = [], []
             for seed in seeds:
                 (u, y), (uv, yv) = data(name, seed, n)
-                true = {"output_order": na, "input_order": nb, "input_delay": nk}
-                with warnings.catch_warnings():
-                    warnings.simplefilter("ignore")
-                    t0 = time.perf_counter()
-                    search = PWARXSearch(PWARX(random_state=0), orders="auto").fit(u, y)
-                    times.append(time.perf_counter() - t0)
-                    told = PWARXSearch(PWARX(random_state=0, **true)).fit(u, y)
-                    arx = PWARX(**true, n_regions=1, segmentation="average").fit(u, y)
-                rows["hwpts"].append(_free_fit(search.best_estimator_, uv, yv))
-                rows["told"].append(_free_fit(told.best_estimator_, uv, yv))
-                rows["arx"].append(_free_fit(arx, uv, yv))
+                search, told, arx, elapsed = three_fits(u, y, {"output_order": na, "input_order": nb,
+                                                                "input_delay": nk})
+                times.append(elapsed)
+                rows["hwpts"].append(free_fit(search.best_estimator_, uv, yv))
+                rows["told"].append(free_fit(told.best_estimator_, uv, yv))
+                rows["arx"].append(free_fit(arx, uv, yv))
                 chosen.append(chosen_label(search.best_estimator_))
             with warnings.catch_warnings():  # a column whose every free run diverged reads nan
                 warnings.simplefilter("ignore", RuntimeWarning)

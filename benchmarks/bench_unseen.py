@@ -123,14 +123,28 @@ def oracle_fit(S, train, valid):
     return fit_percent(yv[m:], ys[m:])
 
 
-def _free_fit(model, uv, yv):
+def free_fit(model, uv, yv):
     """Free-run fit % from the validation's first outputs (``nan`` if the run diverged)."""
     return model.simulate(uv, yv).score(yv)
 
 
-def run(name, seeds):
+def three_fits(u, y, true):
+    """The default search (orders chosen), the search told the orders ``true`` (a dict of
+    ``output_order``, ``input_order``, ``input_delay``), one ARX model of those orders, and the
+    default search's time in seconds."""
     from hwpts.identification import PWARX, PWARXSearch
 
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        t0 = time.perf_counter()
+        search = PWARXSearch(PWARX(random_state=0), orders="auto").fit(u, y)
+        elapsed = time.perf_counter() - t0
+        told = PWARXSearch(PWARX(random_state=0, **true)).fit(u, y)
+        arx = PWARX(**true, n_regions=1, segmentation="average").fit(u, y)
+    return search, told, arx, elapsed
+
+
+def run(name, seeds):
     S = SYSTEMS[name]
     true = {"output_order": S["na"], "input_order": S["nb"], "input_delay": S["nk"]}
     rows = {"hwpts": [], "hwpts, true orders": [], "oracle": [], "ARX": []}
@@ -138,17 +152,12 @@ def run(name, seeds):
     for seed in seeds:
         train, valid = data(S, seed)
         u, y, _ = train
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            t0 = time.perf_counter()
-            search = PWARXSearch(PWARX(random_state=0), orders="auto").fit(u, y)
-            times.append(time.perf_counter() - t0)
-            told = PWARXSearch(PWARX(random_state=0, **true)).fit(u, y)
-            arx = PWARX(**true, n_regions=1, segmentation="average").fit(u, y)
-        rows["hwpts"].append(_free_fit(search.best_estimator_, *valid))
-        rows["hwpts, true orders"].append(_free_fit(told.best_estimator_, *valid))
+        search, told, arx, elapsed = three_fits(u, y, true)
+        times.append(elapsed)
+        rows["hwpts"].append(free_fit(search.best_estimator_, *valid))
+        rows["hwpts, true orders"].append(free_fit(told.best_estimator_, *valid))
         rows["oracle"].append(oracle_fit(S, train, valid))
-        rows["ARX"].append(_free_fit(arx, *valid))
+        rows["ARX"].append(free_fit(arx, *valid))
         chosen.append(chosen_label(search.best_estimator_))
     return rows, chosen, times
 
