@@ -195,6 +195,14 @@ def _alternate_numpy(Phi, ys, Z, labels, s, gamma=1.0, max_iter=50, ridge=1e-8):
     return labels, _objective(Phi, ys, Z, labels, s, gamma, ridge, nf), it
 
 
+def scaled_problem(X, y):
+    """``(Z, ys, Phi)``: the standardised regressors, the standardised output and ``[Z, 1]``, on
+    which the alternation runs."""
+    Z = standardize(X)
+    ys = (y - y.mean()) / (y.std() or 1.0)
+    return Z, ys, np.hstack([Z, np.ones((X.shape[0], 1))])
+
+
 def random_parameter_labels(Phi, ys, s, rng) -> np.ndarray:
     """k-LinReg's start (Lauer 2013): ``s`` parameter vectors drawn from a standard normal (the
     regressors and the output standardised), each row labelled with the one whose prediction is
@@ -305,9 +313,7 @@ class AlternatingSegmenter(Segmenter):
         n = X.shape[0]
         if s == 1:
             return SegmentationResult(np.zeros(n, dtype=np.int64), 1)
-        Z = standardize(X)
-        ys = (y - y.mean()) / (y.std() or 1.0)
-        Phi = np.hstack([Z, np.ones((n, 1))])
+        Z, ys, Phi = scaled_problem(X, y)
         if n <= SUBSET:
             labels, obj, it, r, objectives = self._restarts(X, y, Z, ys, Phi, s, structure, rng)
         else:

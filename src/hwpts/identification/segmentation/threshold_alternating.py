@@ -25,8 +25,8 @@ from __future__ import annotations
 import numpy as np
 
 from hwpts.errors import IdentificationError, ParameterError
-from hwpts.identification.segmentation.alternating import alternate
-from hwpts.identification.segmentation.base import SegmentationResult, Segmenter, standardize
+from hwpts.identification.segmentation.alternating import alternate, scaled_problem
+from hwpts.identification.segmentation.base import SegmentationResult, Segmenter
 from hwpts.identification.segmentation.threshold import ThresholdSegmenter
 from hwpts.identification.settings import check_count, check_number
 
@@ -71,9 +71,7 @@ class ThresholdAlternatingSegmenter(Segmenter):
         info = {"column": split.info.get("column"), "thresholds": split.info.get("thresholds", [])}
         if s == 1:
             return SegmentationResult(split.labels, 1, split.partition, refine=False, info=info)
-        Z = standardize(X)
-        ys = (y - y.mean()) / (y.std() or 1.0)
-        Phi = np.hstack([Z, np.ones((X.shape[0], 1))])
+        Z, ys, Phi = scaled_problem(X, y)
         labels, objective, iterations = alternate(Phi, ys, Z, np.asarray(split.labels, dtype=np.int64), s,
                                                   self.gamma, self.max_iter)
         return SegmentationResult(labels, s, info={**info, "objective": objective, "iterations": iterations})

@@ -671,6 +671,8 @@ class PWARXSearch(BaseEstimator):
             active = list(methods) if number == 0 else list(survivors)
             behind = dict.fromkeys([*methods, REFINED], 0)
             refined = False  # raced from its first count on, once an order (then dropped as any method)
+            arx_row = next((r for r in table if r["params"].get("segmentation") == "average"
+                            and self._same_orders(r, orders)), None)  # the first: no powers, no polish
             for s in range(2, max(top, 1) + 1):
                 cands = [{**orders, "segmentation": m, "n_regions": s,
                           "segmentation_params": METHOD_PARAMS.get(m)} for m in active]
@@ -688,7 +690,7 @@ class PWARXSearch(BaseEstimator):
                     leader = None
                 overall = -np.inf if leader is None else self._score(leader)
                 rows = self._run(base, cands, u, y, splits, "regions", bar, overall, leader)
-                if refine and not refined and REFINED not in active and self._split_hurts(rows, table, orders):
+                if refine and not refined and REFINED not in active and self._split_hurts(rows, arx_row):
                     refined = True
                     # the split's free run is worse than no split: its cut lies across the true
                     # boundary, so the split refined into oblique boundaries races from here on
@@ -975,18 +977,15 @@ class PWARXSearch(BaseEstimator):
         best_free = max((self._free(r) for r in arx_rows), default=-np.inf)
         self.scoring_ = "one_step" if best_free < FREE_RUN_FLOOR else "free_run"
 
-    def _split_hurts(self, rows, table, orders) -> bool:
+    def _split_hurts(self, rows, arx) -> bool:
         """Whether this count's ``threshold`` model's free run scored below the single ARX model's
-        of the same orders on the blocks it was scored on (or diverged): a cut across the true
+        (``arx``, its row) on the blocks it was scored on (or diverged): a cut across the true
         boundaries, e.g. one that makes a saturated state absorbing in free run. Not where the
         one-step fit ranks the candidates (a chaotic free run: on the zoo's ``pwarx_random`` the
         refinement then raced on some data sets and won, one-step fit 96.2 -> 95.2 %)."""
         split = next((r for r in rows if r["params"].get("segmentation") == "threshold"), None)
         if split is None or split.get("error") or self.scoring_ == "one_step":
             return False  # ranked by the one-step fit, the free run is chaotic: no evidence
-        arx = next((r for r in table if r["params"].get("segmentation") == "average"
-                    and not r["params"].get("output_powers") and not r["params"].get("polish")
-                    and {k: r["params"][k] for k in ORDER_KEYS if k in r["params"]} == dict(orders)), None)
         if arx is None or not arx["split_fits_percent"]:
             return False
         if split.get("diverged"):
