@@ -16,7 +16,8 @@ free run from the validation's first outputs. Columns: the default search (order
 search told the plant's orders, one ARX model of those orders (``nan``: its free run diverged),
 the search's time and choice.
 
-``python -m benchmarks textbook [--seeds=N] [--systems=a,b]`` (1 seed by default).
+``python -m benchmarks textbook [--seeds=N] [--systems=a,b]`` (1 seed by default);
+``--methods [--seeds=5]``: the tank's three segmentation methods side by side (:func:`tank_methods`).
 """
 
 from __future__ import annotations
@@ -101,12 +102,48 @@ def data(name, seed, n):
     return (u, simulate(name, u, e)), (uv, simulate(name, uv))
 
 
+def tank_methods(seeds) -> None:
+    """``--methods``: on ``integrator_sat`` (3,000 samples, the true orders 1/1/1, 3 regions), per
+    seed, the free-run fit % of ``threshold``, ``alternating`` and ``threshold-alternating`` on the
+    noise-free validation record; the alternation's objective where ``alternating`` landed, where
+    ``threshold-alternating`` landed (from the split), and at the true modes' labels; and the
+    learned boundaries' input-to-output weight ratio (the true boundaries' is 0.2)."""
+    from hwpts.identification import PWARX
+    from hwpts.identification.segmentation.alternating import _objective, scaled_problem
+
+    print("integrator_sat, 3,000 samples, na 1, nb 1, nk 1, 3 regions: free-run fit % (noise-free validation); "
+          "alternation objective; boundary weight ratio |w_u / w_y|")
+    print(f"{'seed':>4s} {'threshold':>10s} {'alternating':>12s} {'thr-alt':>8s}   {'obj alt':>8s} {'obj thr-alt':>11s} "
+          f"{'obj true':>9s}   ratio")
+    for seed in seeds:
+        (u, y), (uv, yv) = data("integrator_sat", seed, 3000)
+        fits, objective = {}, {}
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            for method in ("threshold", "alternating", "threshold-alternating"):
+                model = PWARX(1, 1, 1, n_regions=3, segmentation=method, random_state=0).fit(u, y)
+                fits[method] = free_fit(model, uv, yv)
+                objective[method] = model.segmentation_info_.get("objective", np.nan)
+        X, t = np.column_stack([y[:-1], u[:-1, 0]]), y[1:]
+        raw = X[:, 0] + 0.2 * X[:, 1]
+        true = np.where(raw <= 0, 0, np.where(raw >= 10, 2, 1))
+        Z, ys, Phi = scaled_problem(X, t)
+        at_true = _objective(Phi, ys, Z, true, 3, 1.0, 1e-8, Z.shape[1])
+        ratios = [abs(h[1] / h[0]) for H in model.partition_.H for h in H]
+        print(f"{seed:4d} {fits['threshold']:10.1f} {fits['alternating']:12.1f} {fits['threshold-alternating']:8.1f}   "
+              f"{objective['alternating']:8.5f} {objective['threshold-alternating']:11.5f} {at_true:9.5f}   "
+              f"{min(ratios):.2f}-{max(ratios):.2f}", flush=True)
+
+
 def main(argv=None) -> int:
     parsed = seeds_and_systems(list(argv or []), SYSTEMS, "textbook")
     if parsed is None:
         return 2
     seeds, names = parsed
     seeds = seeds if any(a.startswith("--seeds=") for a in argv or []) else [0]
+    if "--methods" in (argv or []):
+        tank_methods(seeds)
+        return 0
     print(f"free-run fit % on noise-free validation, median [min, max] over {len(seeds)} seed(s); "
           f"noise {NOISE:.0%} of the output's std (equation error)")
     print(f"{'system':21s} {'N':>5s} {'hwpts':>22s} {'hwpts, true orders':>22s} {'ARX':>22s} "
