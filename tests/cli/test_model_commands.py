@@ -38,6 +38,13 @@ def test_identify_prints_summary_and_writes_model(tmp_path, data_csv, capsys):
     summary = json.loads(capsys.readouterr().out)
     assert code == 0 and out.exists()
     assert summary["n_regions"] == 3 and summary["segmentation"] == "alternating"
+    # the method and count told, na searched: the orders ranked as ARX models, then that method alone at that count
+    assert main(["identify", str(data_csv), *IDENTIFY[:6], "--nb", "2", "--segmentation", "alternating",
+                 "--regions", "3", "--out", str(out)]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["n_regions"] == 3 and summary["segmentation"] == "alternating"
+    assert {(r["segmentation"], r["n_regions"]) for r in summary["candidates"]
+            if r["stage"] != "powers"} == {("average", 1), ("alternating", 3)}
     assert summary["train_fit_percent"] > 50 and summary["train_one_step_fit_percent"] > 80
     assert json.loads(out.read_text())["schema"] == "hwpts.pwarx/1"
     # system 5 switches on y(k-1) - u2(k-1): the learned partition keeps those two columns
@@ -313,24 +320,28 @@ def test_search_bad_inputs_give_one_line(tmp_path, data_csv, capsys):
 
 
 def test_regions_given_method_auto_chooses_among_the_default_methods(tmp_path, data_csv, capsys):
-    """--regions S without --segmentation: each default method with S regions is scored on the
-    held-out blocks (it fitted the library's clustering before, and with the orders left open it
-    stopped on "segmentation 'auto' is a model search")."""
+    """--regions S without --segmentation: the adaptive search at S regions only (``n_regions=S``):
+    each default method with S regions is scored on the held-out blocks beside the single ARX
+    model, which only ranks the orders, and the choice has S regions (it fitted the library's
+    clustering before, and with the orders left open it stopped on "segmentation 'auto' is a model
+    search"; then a grid over every order and method, 38 s on Silverbox where this takes 4 s)."""
     from hwpts.identification.selection import DEFAULT_METHODS
 
     out = tmp_path / "m.json"
     assert main(["identify", str(data_csv), *IDENTIFY, "--regions", "3", "--out", str(out)]) == 0
     summary = json.loads(capsys.readouterr().out)
-    assert summary["segmentation"] in DEFAULT_METHODS
-    assert sorted(r["segmentation"] for r in summary["candidates"] if r["stage"] == "grid") == sorted(DEFAULT_METHODS)
-    assert {r["n_regions"] for r in summary["candidates"]} == {3}
+    assert summary["segmentation"] in (*DEFAULT_METHODS, "threshold-alternating") and summary["n_regions"] == 3
+    raced = {r["segmentation"] for r in summary["candidates"] if r["stage"] == "regions" and r["n_regions"] == 3}
+    assert set(DEFAULT_METHODS) <= raced
+    assert {r["n_regions"] for r in summary["candidates"]} == {1, 3}
+    assert "chosen among those with the 3 region(s) asked for" in summary["choice"]["why"]
     rows = tmp_path / "short.csv"
     d = make_system(5, rng=0, n=400)
     write_csv(rows, {"u1": d.inputs[:, 0], "u2": d.inputs[:, 1], "y": d.output})
     assert main(["identify", str(rows), "--input", "u1", "--input", "u2", "--output", "y", "--regions", "2",
                  "--out", str(out)]) == 0
     summary = json.loads(capsys.readouterr().out)
-    assert summary["segmentation"] in DEFAULT_METHODS and summary["n_regions"] == 2
+    assert summary["segmentation"] in (*DEFAULT_METHODS, "threshold-alternating") and summary["n_regions"] == 2
     assert main(["identify", str(data_csv), *IDENTIFY, "--regions", "1", "--out", str(out)]) == 0
     assert json.loads(capsys.readouterr().out)["segmentation"] == "average"
 

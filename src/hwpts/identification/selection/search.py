@@ -28,7 +28,7 @@ Two ways to say what to try:
      delays 0 and 1 of :data:`ORDER_GRID` become the estimated dead time and one less where
      :func:`~hwpts.identification.selection.orders.estimate_delays` finds one: see ``orders``);
   2. **regions**: for each kept order, one region (ARX), then 2, 3, ... regions with every method
-     of ``methods``; the count grows until ``patience`` successive counts improve neither the best
+     of ``methods`` (``n_regions`` an int: that count only, and the choice among its models); the count grows until ``patience`` successive counts improve neither the best
      free-run score nor the best held-out one-step fit (on a system whose free run is chaotic the
      free run alone cannot tell 3 regions from 6), or until every region would hold fewer than
      ``3 p`` rows; past 10 regions it goes on only while the held-out free-run fit itself keeps
@@ -313,6 +313,12 @@ class PWARXSearch(BaseEstimator):
         Largest number of regions tried ("auto": 10, more while the held-out free-run fit keeps
         rising, at most 40, and while the training rows hold ``3 p`` rows a region for ``p``
         parameters a mode).
+    n_regions : int or "auto"
+        ``"auto"`` (default): the number of regions is chosen as above. An int fixes it: the
+        orders are still ranked as single ARX models and the carried ones raced, with each method
+        of ``methods``, at that count only (not the shared modes of step 3, whose ``K`` modes make
+        ``K`` or more regions), and the choice is made among the candidates with that count
+        (``1``: among the single ARX models, with the power terms). ``max_regions`` is then not used.
     patience : int
         Region counts in a row without a better score before the growth stops.
     tolerance : float
@@ -389,7 +395,7 @@ class PWARXSearch(BaseEstimator):
     """
 
     def __init__(self, estimator=None, param_grid=None, *, cv=None, methods=DEFAULT_METHODS, orders=None,
-                 n_orders: int = 3, max_regions="auto", patience: int = 2, tolerance: float = 0.5,
+                 n_orders: int = 3, max_regions="auto", n_regions="auto", patience: int = 2, tolerance: float = 0.5,
                  try_polish="auto", refit_margin: float = 5.0, n_jobs=None, progress: bool = False,
                  scoring: str = "auto", shared_modes="auto", order_ranking: str = "neighbours",
                  n_standard_errors: float = 1.0, output_powers="auto"):
@@ -400,6 +406,7 @@ class PWARXSearch(BaseEstimator):
         self.orders = orders
         self.n_orders = n_orders
         self.max_regions = max_regions
+        self.n_regions = n_regions
         self.patience = patience
         self.tolerance = tolerance
         self.try_polish = try_polish
@@ -659,6 +666,7 @@ class PWARXSearch(BaseEstimator):
         # raced and it is not raced already (``methods=("threshold",)`` asks for threshold alone)
         names = {getattr(m, "name", m) for m in methods}  # a segmenter instance by its method's name
         refine = {"threshold", "alternating"} <= names and REFINED not in names
+        fixed = self._fixed()
         for number, orders in enumerate(keep):
             best, best_one = self._bests(table, orders)
             top = min(self._room(base, orders, u, splits),
@@ -673,18 +681,21 @@ class PWARXSearch(BaseEstimator):
             refined = False  # raced from its first count on, once an order (then dropped as any method)
             arx_row = next((r for r in table if r["params"].get("segmentation") == "average"
                             and self._same_orders(r, orders)), None)  # the first: no powers, no polish
-            for s in range(2, max(top, 1) + 1):
+            for s in self._counts(top):
                 cands = [{**orders, "segmentation": m, "n_regions": s,
                           "segmentation_params": METHOD_PARAMS.get(m)} for m in active]
+                # with a fixed count the race is among the models of that count: pruned against an
+                # ARX model they trail, none would be left to choose from
+                pool = table if fixed is None else [r for r in table if (r["params"].get("n_regions") or 1) == fixed]
                 if number == 0:
-                    leader = max(table, key=self._score, default=None)
+                    leader = max(pool, key=self._score, default=None)
                 else:
                     # a runner-up order races the best model with at most as many regions, not the
                     # overall leader grown further: at 2-3 regions it would trail an order grown to
                     # 6 whatever it is worth (EMPS: two orders whose ARX fits tie within 0.03
                     # points; the one carried second, raced against the first's 6 regions, stopped
                     # at 3 and lost 98.1 % held-out fit for 97.5 %)
-                    leader = max((r for r in table if (r["params"].get("n_regions") or 1) <= s),
+                    leader = max((r for r in pool if (r["params"].get("n_regions") or 1) <= s),
                                  key=self._score, default=None)
                 if leader is not None and not np.isfinite(self._score(leader)):
                     leader = None
@@ -741,6 +752,18 @@ class PWARXSearch(BaseEstimator):
         table.extend(self._powers_stage(base, table, u, y, splits, bar))
         return table
 
+    def _fixed(self):
+        """The number of regions the user fixed (``n_regions``), or ``None``."""
+        return None if isinstance(self.n_regions, str) else int(self.n_regions)
+
+    def _counts(self, top: int):
+        """The region counts the region stage tries for one order: 2 up to ``top`` (the growth rule
+        stops it earlier), or the fixed count alone."""
+        fixed = self._fixed()
+        if fixed is None:
+            return range(2, max(top, 1) + 1)
+        return [fixed] if fixed >= 2 else []
+
     def _methods(self) -> tuple:
         """The segmentation methods to race: names of
         :data:`~hwpts.identification.segmentation.SEGMENTATION_METHODS` or segmenter instances
@@ -774,6 +797,8 @@ class PWARXSearch(BaseEstimator):
             check_count(getattr(self, name), name, 1, owner)
         if self.max_regions != "auto" and not is_count(self.max_regions, 1):
             raise ParameterError(f"PWARXSearch: max_regions must be 'auto' or an int >= 1, got {self.max_regions!r}")
+        if self.n_regions != "auto" and not is_count(self.n_regions, 1):
+            raise ParameterError(f"PWARXSearch: n_regions must be 'auto' or an int >= 1, got {self.n_regions!r}")
         if not (isinstance(self.try_polish, (bool, np.bool_)) or (isinstance(self.try_polish, str)
                                                                     and self.try_polish == "auto")):
             raise ParameterError(f"PWARXSearch: try_polish must be True, False or 'auto', got {self.try_polish!r}")
@@ -895,8 +920,8 @@ class PWARXSearch(BaseEstimator):
         orders, when ``shared_modes`` says so: ``True`` always, ``"auto"`` when the gate opens
         (:meth:`_modes_gate`). The number of modes grows from the gate's count while the score or
         the one-step fit improves (``patience``), as in the region stage."""
-        if self.shared_modes is False or "switched" in self._methods():
-            return []
+        if self.shared_modes is False or "switched" in self._methods() or self._fixed() is not None:
+            return []  # (K modes make K or more regions: not a count the user fixed)
         ok = [r for r in table if np.isfinite(self._score(r))]
         if not ok:
             return []
@@ -1054,10 +1079,15 @@ class PWARXSearch(BaseEstimator):
     def _preference(self, base, table, u):
         """Candidates in the order they are tried for the refit: those the best does not beat
         (:meth:`_beats`), fewer regions then fewer parameters first; then the rest by score."""
+        fixed = self._fixed()
+        if fixed is not None:  # the count the user fixed: the other rows (the ARX stage's) only ranked the orders
+            table = [r for r in table if (r["params"].get("n_regions") or 1) == fixed]
         ok = [r for r in table if np.isfinite(self._score(r))]
         if not ok:
             reasons = sorted({r["error"] or "free run diverged" for r in table})[:3]
-            raise IdentificationError("every candidate model diverged in free run or failed: " + "; ".join(reasons))
+            count = "" if fixed is None else f" with {fixed} region{'s' if fixed > 1 else ''}"
+            raise IdentificationError(f"every candidate model{count} diverged in free run or failed: "
+                                      + "; ".join(reasons))
         best = max(ok, key=self._score)
         near = [r for r in ok if not self._beats(best, r)]
         # the output powers after every affine model: they must beat the affine pieces, as the
