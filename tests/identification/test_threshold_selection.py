@@ -715,3 +715,5 @@ def test_a_fixed_count_is_chosen_even_where_one_arx_model_scores_better(monkeypa
     for bad in (0, 2.5, "three", True):
         with pytest.raises(ParameterError, match=r"PWARXSearch: n_regions must be 'auto' or an int >= 1"):
             PWARXSearch(PWARX(1, 1, 1), n_regions=bad).fit(u, y)
+    with pytest.raises(ParameterError, match=r"with a param_grid give the counts in the grid"):
+        PWARXSearch(PWARX(1, 1, 1), param_grid={"n_regions": [2, 3]}, n_regions=3).fit(u, y)

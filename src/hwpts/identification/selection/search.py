@@ -799,6 +799,9 @@ class PWARXSearch(BaseEstimator):
             raise ParameterError(f"PWARXSearch: max_regions must be 'auto' or an int >= 1, got {self.max_regions!r}")
         if self.n_regions != "auto" and not is_count(self.n_regions, 1):
             raise ParameterError(f"PWARXSearch: n_regions must be 'auto' or an int >= 1, got {self.n_regions!r}")
+        if self.n_regions != "auto" and self.param_grid is not None:
+            raise ParameterError(f"PWARXSearch: n_regions={self.n_regions!r} fixes the adaptive search's count; with a "
+                                 f"param_grid give the counts in the grid (its 'n_regions') and leave n_regions 'auto'")
         if not (isinstance(self.try_polish, (bool, np.bool_)) or (isinstance(self.try_polish, str)
                                                                     and self.try_polish == "auto")):
             raise ParameterError(f"PWARXSearch: try_polish must be True, False or 'auto', got {self.try_polish!r}")
