@@ -18,8 +18,10 @@ import _signal  # the C module: ``signal`` imports ``enum`` first, 10 ms more of
 
 
 def _interrupt(signum, frame):
-    cli = sys.modules.get("hwpts.cli")
-    if cli is not None and cli._SETTLED.is_set():  # the run is over (main restored this handler):
+    # ``hwpts.cli`` may be in sys.modules half imported (a signal in its first milliseconds):
+    # without its ``_SETTLED`` yet the run has not begun, and the signal interrupts it
+    settled = getattr(sys.modules.get("hwpts.cli"), "_SETTLED", None)
+    if settled is not None and settled.is_set():  # the run is over (main restored this handler):
         return  # its status stands
     raise KeyboardInterrupt
 
