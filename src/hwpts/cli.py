@@ -170,8 +170,26 @@ def _run(argv: Sequence[str] | None) -> int:
             # a stop that lands after an output was committed cannot undo it: say so
             print("hwpts: interrupted" + (f" after writing {', '.join(written)}" if written else ""), file=sys.stderr)
             return 130
+        if _stdout_failed(error):
+            # the report printed after the outputs were committed (a full disk behind stdout): the
+            # line names the stream, and the files that are complete all the same
+            written = _written_since(args, before)
+            print(f"hwpts: error: standard output: cannot write ({error.strerror or error})"
+                  + (f"; {', '.join(written)} {'was' if len(written) == 1 else 'were'} written in full"
+                     if written else ""), file=sys.stderr)
+            return EXIT_USAGE
         return _report(error)
     return status
+
+
+def _stdout_failed(error: BaseException) -> bool:
+    """Whether ``error`` is a failed write to standard output (not a closed pipe, which is no error:
+    ``| head``): an OSError that names no file, of the kinds a write fails with (a full disk or
+    device, an I/O error). Files are written through :mod:`hwpts.io.atomic`, which names them."""
+    import errno
+
+    return (isinstance(error, OSError) and not isinstance(error, BrokenPipeError) and error.filename is None
+            and error.errno in (errno.ENOSPC, errno.EIO, errno.EDQUOT, errno.EFBIG))
 
 
 def _outputs(args) -> dict:

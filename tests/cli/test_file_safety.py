@@ -549,3 +549,35 @@ def test_a_signal_while_the_cli_module_is_half_imported_is_an_interrupt(monkeypa
     monkeypatch.setitem(sys.modules, "hwpts.cli", types.ModuleType("hwpts.cli"))
     with pytest.raises(KeyboardInterrupt):
         _console._interrupt(signal.SIGTERM, None)
+
+
+def test_a_full_disk_behind_standard_output_names_the_stream_and_the_files_written(monkeypatch, capsys, tmp_path):
+    """A report printed after the output was committed, to a stdout that cannot take it
+    (``hwpts predict ... --out p.csv >/dev/full``): one line naming standard output and the file,
+    complete all the same, exit 2 (it said ``hwpts: error: No space left on device``). A closed
+    pipe (``| head``) stays no error."""
+    import errno
+
+    out = tmp_path / "p.csv"
+
+    class Full:
+        def write(self, text):
+            raise OSError(errno.ENOSPC, "No space left on device")
+
+        def flush(self):
+            pass
+
+    def handler(args):
+        out.write_text("t,y\n0,1\n")
+        monkeypatch.setattr(sys, "stdout", Full())
+        print("predicted 1 sample")
+        return 0
+
+    assert _run_with_handler(monkeypatch, handler, ("fake", "--out", str(out))) == 2
+    assert capsys.readouterr().err == (f"hwpts: error: standard output: cannot write (No space left on device); "
+                                       f"{out} was written in full\n")
+
+    def piped(args):
+        raise BrokenPipeError(errno.EPIPE, "Broken pipe")
+
+    assert _run_with_handler(monkeypatch, piped) == 0
