@@ -89,11 +89,23 @@ def test_missing_cells_are_nan_in_either_reader_and_a_hex_cell_is_refused_with_i
         read_table(path)
     path.write_text("u,y,note\n1,2,id 0x2A\n3,4,b\n")  # a hex-looking text in a column not read
     np.testing.assert_array_equal(read_table(path, ["u", "y"])["u"], [1.0, 3.0])
-    path.write_text("u,y\n1,2\n\n\n2,abc\n")
+    path.write_text("\nu,y\n\n1,2\n3,abc\n")
     with pytest.raises(DataError, match="line 5, column 'y': expected a number, got 'abc'"):
         read_table(path)
-    path.write_text("u,y\n1,2\n \n2,3\u00a0\n\n")  # blank lines are no rows; a no-break space is a space
+    path.write_text("u,y\n \n1,2\n2,3\u00a0\n\n \n")  # blank lines around the rows are no rows; a no-break space is a space
     np.testing.assert_array_equal(read_table(path)["y"], [2.0, 3.0])
+
+
+@pytest.mark.parametrize("gap", ["\n", " \n", "\t\r\n"])
+@pytest.mark.parametrize("tail", [",", ""])  # the line-by-line reader (a trailing comma), pyarrow's
+def test_a_blank_line_between_data_rows_is_refused_with_its_line(tmp_path, gap, tail):
+    """A blank line between data rows was skipped by both readers: the samples on either side were
+    read as neighbours, silently (a record of 600 rows with row 100 blanked read as 599 samples;
+    two records separated by a blank line read as one)."""
+    path = tmp_path / "b.csv"
+    path.write_text(f"u,y{tail}\n1,2{tail}\n3,4{tail}\n{gap}5,6{tail}\n")
+    with pytest.raises(DataError, match=r"line 4: expected a data row, got a blank line between data rows"):
+        read_table(path)
 
 
 @pytest.mark.parametrize("text", [

@@ -9,6 +9,7 @@ from __future__ import annotations
 import csv
 import io
 import os
+import re
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -79,6 +80,8 @@ def read_csv(path: str | os.PathLike, columns=None) -> dict[str, np.ndarray]:
 
     p = Path(path)
     delimiter = _sniff(p)
+    if _blank_line_inside(p):  # pyarrow skips it: the line-by-line reader refuses one between data rows
+        return _read_csv_python(p, delimiter, columns)
     try:
         table = pacsv.read_csv(p, parse_options=pacsv.ParseOptions(delimiter=delimiter))
     except (pa.ArrowInvalid, pa.ArrowTypeError, UnicodeDecodeError):
@@ -110,6 +113,17 @@ def read_csv(path: str | os.PathLike, columns=None) -> dict[str, np.ndarray]:
     if integers and _has_hex(p, delimiter, integers):  # pyarrow reads "0x10" as 16; no CSV writer means that
         return _read_csv_python(p, delimiter, columns)  # refuses the cell, naming its line
     return out
+
+
+_BLANK_INSIDE = re.compile(rb"\n[ \t\r\f\v]*\n[ \t\r\n\f\v]*[^ \t\r\n\f\v]")
+
+
+def _blank_line_inside(p: Path) -> bool:
+    """Whether the file has a blank (or white) line followed by more text."""
+    try:
+        return _BLANK_INSIDE.search(p.read_bytes()) is not None
+    except OSError:
+        return False  # the reader says why
 
 
 def _has_hex(p: Path, delimiter: str, names: list[str]) -> bool:
@@ -183,13 +197,21 @@ def _read_csv_python(p: Path, delimiter: str = ",", columns=None) -> dict[str, n
         raise DataError(f"{str(p)!r}: not a UTF-8 text file, expected CSV") from None
     except OSError as error:
         raise DataError(f"{str(p)!r}: cannot read ({error.strerror or error})") from None
-    # (line number, row); a blank line is skipped, as the fast reader skips it, but a row of empty
-    # fields (",,") is a row of missing values: dropped, it shifted every later sample in silence
+    # (line number, row); a blank line before the first data row or after the last is skipped, but
+    # one between data rows is refused: skipped, it joined the samples on either side (two records
+    # separated by a blank line read as one); a row of empty fields (",,") is a row of missing
+    # values: dropped, it shifted every later sample in silence
     reader = csv.reader(io.StringIO(text), delimiter=delimiter)
-    numbered, line = [], 1
+    numbered, line, blank = [], 1, None
     for row in reader:
         if len(row) > 1 or (row and row[0].strip()):
+            if blank is not None:
+                raise DataError(f"{str(p)!r} line {blank}: expected a data row, got a blank line between data rows "
+                                f"(the samples on either side would be read as neighbours); remove it, or split "
+                                f"the file where one record ends")
             numbered.append((line, row))
+        elif len(numbered) >= 2 and blank is None:
+            blank = line
         line = reader.line_num + 1
     if not numbered:
         raise DataError(f"{str(p)!r}: empty file, expected a header row of column names")
