@@ -92,3 +92,38 @@ def test_two_rows_far_apart_are_integrated():
     per-interval guard of 100,000 steps called it a solver failure ('lower rtol')."""
     sim = simulate_plant(PlantParameters.paper(), np.array([0.0, 6000.0]), 2.4, 700.0)
     assert np.all(np.isfinite(sim.motor_a_speed_rpm))
+
+
+def test_a_grid_integrated_in_chunks_steps_as_in_one_piece(monkeypatch):
+    """The grid is integrated CHUNK intervals at a time (Python's signal handlers run between two
+    calls of the compiled loop: a profile of 10^6 s ignored Ctrl-C until it ended), the step size
+    carried from one call to the next: chunks of 7 intervals give case 3 bit for bit."""
+    from hwpts.plant import simulate as S
+
+    case = validation_case("case3")
+    whole = simulate_plant(PlantParameters.paper(), case.time, case.valve_voltage_v, case.pump_speed_rpm)
+    monkeypatch.setattr(S, "CHUNK", 7)
+    chunked = simulate_plant(PlantParameters.paper(), case.time, case.valve_voltage_v, case.pump_speed_rpm)
+    np.testing.assert_array_equal(chunked.state, whole.state)
+    assert chunked.stats == whole.stats
+
+
+def test_a_long_hold_is_cut_into_pieces_and_the_rows_kept():
+    """A hold longer than LONG_HOLD is integrated in pieces of at most that length (each a chunk
+    boundary where a signal can land); the response is given at the rows of ``time`` only, and a
+    25 s hold agrees with the same hold given as rows 1 s apart to the solver's tolerance."""
+    from hwpts.plant.simulate import LONG_HOLD, _held_grid
+
+    t = np.array([0.0, 0.5, 25.5, 26.0])
+    grid, source = _held_grid(t, LONG_HOLD)
+    assert np.all(np.isin(t, grid)) and np.max(np.diff(grid)) <= LONG_HOLD
+    np.testing.assert_array_equal(source[np.searchsorted(grid, t)], np.arange(4))
+    assert np.all(t[source] <= grid) and np.all(np.diff(source) >= 0)
+    v, w = np.array([2.4, 3.2, 2.6, 2.6]), np.array([700.0, 700.0, 800.0, 800.0])
+    sim = simulate_plant(PlantParameters.paper(), t, v, w)
+    assert sim.state.shape == (4, 5)
+    fine = np.r_[0.0, np.arange(0.5, 25.5, 1.0), 25.5, 26.0]
+    rows = np.searchsorted(fine, t)
+    held = np.searchsorted(t, fine, side="right") - 1  # the row whose inputs hold at each fine instant
+    ref = simulate_plant(PlantParameters.paper(), fine, v[held], w[held])
+    np.testing.assert_allclose(sim.motor_a_speed_rpm, ref.motor_a_speed_rpm[rows], rtol=1e-4)

@@ -30,6 +30,12 @@ _TAU = _I["spool_time_constant"]
 _GAMMA = 1.0 + 1.0 / math.sqrt(2.0)
 _NZ = N_STATES + 1  # the 5 states + the spool position
 
+# the grid is integrated in chunks of CHUNK intervals, a hold longer than LONG_HOLD seconds cut
+# into pieces of at most that length: between two calls of the compiled loop Python runs its
+# signal handlers (a profile of 10^6 s in one call ignored Ctrl-C and SIGTERM until it ended)
+CHUNK = 2000
+LONG_HOLD = 10.0
+
 DEFAULT_RTOL = 1e-5
 DEFAULT_ATOL = (50.0, 50.0, 50.0, 1e-3, 1e-3, 1e-9)
 """Absolute tolerances: pressures [Pa], speeds [rad/s], spool [m]."""
@@ -91,8 +97,10 @@ def _f(z, h_cmd, wp_cmd, p, out):
 
 
 @numba.njit(cache=True)
-def _integrate(t, h_cmd, wp_cmd, p, z0, rtol, atol, max_step, out, stats):
-    """ROS2 with step control over the sample grid t; out[k] = z(t[k]). Returns -1 or a failed index."""
+def _integrate(t, h_cmd, wp_cmd, p, z0, rtol, atol, max_step, out, stats, hstate):
+    """ROS2 with step control over the sample grid t; out[k] = z(t[k]). Returns -1 or a failed index.
+    ``hstate[0]``: the step size to start with, and on return the one to go on with (a grid
+    integrated in chunks steps as in one piece)."""
     n = t.shape[0]
     z = z0.copy()
     for i in range(_NZ):
@@ -107,7 +115,7 @@ def _integrate(t, h_cmd, wp_cmd, p, z0, rtol, atol, max_step, out, stats):
     zn = np.empty(_NZ)
     ft = np.empty(_NZ)
     tau = p[_TAU]
-    hstep = min(1e-3, max_step)
+    hstep = hstate[0]
     for k in range(n - 1):
         if tau <= 0.0:
             z[N_STATES] = h_cmd[k]
@@ -179,7 +187,21 @@ def _integrate(t, h_cmd, wp_cmd, p, z0, rtol, atol, max_step, out, stats):
                     return k
         for i in range(_NZ):
             out[k + 1, i] = z[i]
+    hstate[0] = hstep
     return -1
+
+
+def _held_grid(t: np.ndarray, long_hold: float):
+    """``(grid, source)``: the instants ``t`` with every hold longer than ``long_hold`` cut into
+    equal pieces of at most that length, and for each grid instant the sample whose inputs hold there."""
+    steps = np.diff(t)
+    pieces = np.maximum(1, np.ceil(steps / long_hold).astype(np.int64)) if t.size > 1 else np.zeros(0, np.int64)
+    if not np.any(pieces > 1):
+        return t, np.arange(t.size)
+    source = np.repeat(np.arange(t.size - 1), pieces)
+    within = np.arange(source.size) - np.repeat(np.cumsum(pieces) - pieces, pieces)
+    grid = np.concatenate([t[source] + steps[source] * within / pieces[source], t[-1:]])
+    return grid, np.concatenate([source, [t.size - 1]])
 
 
 @dataclass(frozen=True)
@@ -304,16 +326,25 @@ def simulate_plant(
         if x0.shape != (N_STATES,) or not np.all(np.isfinite(x0)):
             raise DataError(f"initial_state must be 5 finite numbers, got {initial_state!r}")
     z0 = np.concatenate([x0, h_cmd[:1]])
-    out = np.empty((n, N_STATES + 1))
+    grid, source = _held_grid(t, LONG_HOLD)
+    h_grid, wp_grid = np.ascontiguousarray(h_cmd[source]), np.ascontiguousarray(wp_cmd[source])
+    out_grid = np.empty((grid.size, _NZ))
+    out_grid[0] = z0
     stats = np.zeros(4, dtype=np.int64)
     atol = np.array(DEFAULT_ATOL)
-    failed = _integrate(t, h_cmd, wp_cmd, p, z0, float(rtol), atol, float(max_step), out, stats)
-    if failed >= 0:
-        raise SimulationError(
-            f"integration failed between t = {t[failed]:.6g} s and {t[failed + 1]:.6g} s "
-            f"(step size underflow or non-finite state after {stats[0]} steps); "
-            "check the parameters and inputs, or lower rtol"
-        )
+    hstate = np.array([min(1e-3, float(max_step))])
+    for a in range(0, grid.size - 1, CHUNK):
+        b = min(a + CHUNK, grid.size - 1)
+        failed = _integrate(grid[a:b + 1], h_grid[a:b + 1], wp_grid[a:b + 1], p, out_grid[a].copy(), float(rtol),
+                            atol, float(max_step), out_grid[a:b + 1], stats, hstate)
+        if failed >= 0:
+            k = int(source[a + failed])
+            raise SimulationError(
+                f"integration failed between t = {t[k]:.6g} s and {t[k + 1]:.6g} s "
+                f"(step size underflow or non-finite state after {stats[0]} steps); "
+                "check the parameters and inputs, or lower rtol"
+            )
+    out = out_grid[np.searchsorted(grid, t)] if grid.size != t.size else out_grid
     state = out[:, :N_STATES]
     wp_actual = pump_speed_actual.py_func(state[:, 0], wp_cmd, p)
     return PlantResponse(
@@ -366,6 +397,7 @@ class PlantStepper:
         self._atol = np.array(DEFAULT_ATOL)
         self._rtol = float(rtol)
         self._max_step = float(max_step)
+        self._hstate = np.zeros(1)
         self.effective_voltage_v = float(valve_voltage)
         h0 = spool_position(np.array([valve_voltage]), parameters)
         x0, _ = solve_steady_state(parameters, h0, np.array([pump_speed * RAD_S_PER_RPM]))
@@ -408,8 +440,9 @@ class PlantStepper:
         span = p.valve_voltage_closed - p.valve_voltage_open
         self._h[0] = p.spool_stroke * min(max((v_eff - p.valve_voltage_open) / span, 0.0), 1.0)
         self._w[0] = max(pump_speed, 0.0) * RAD_S_PER_RPM
+        self._hstate[0] = min(1e-3, self._max_step)  # each sample starts afresh, as it always has
         failed = _integrate(self._t, self._h, self._w, self._p, self._z, self._rtol, self._atol, self._max_step,
-                            self._out, self._stats)
+                            self._out, self._stats, self._hstate)
         if failed >= 0:
             raise SimulationError(f"integration failed in the sample after t = {self.time:.6g} s "
                                   "(step size underflow or non-finite state)")
