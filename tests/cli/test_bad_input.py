@@ -250,7 +250,7 @@ CASES = [
     (["identify", f"{W}/data.csv", *FIXED, "--regions", "4", "--out", f"{W}/m.json"], "--regions 4"),
     (["identify", f"{W}/data.csv", *FIT, "--segmentation", "zscore", "--regions", "3", "--out", f"{W}/m.json"], "--regions 3"),
     (["identify", f"{W}/data.csv", *FIT, "--na", "1", "--nb", "1", "--segmentation", "threshold", "--regions", "40",
-      "--out", f"{W}/m.json"], "--regions 40: expected at most 33 for 400 samples"),
+      "--out", f"{W}/m.json"], "--regions 40: expected at most 33 for --segmentation threshold (a threshold split"),
     (["identify", f"{W}/constant_y.csv", *FIT, "--out", f"{W}/m.json"], "output 'y' is constant"),
     (["identify", f"{W}/data.csv", *FIXED, "--output-powers", "1,3", "--out", f"{W}/m.json"],
      "--output-powers: expected 'auto', 'none' or distinct powers 2-9 such as 2,3; got '1,3'"),
