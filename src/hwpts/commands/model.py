@@ -185,7 +185,8 @@ def _resampled(data, dt, model_dt):
     """``data`` linearly interpolated onto the model's sample time (``--resample``)."""
     from hwpts.dataset import IODataset
 
-    count = (data.time[-1] - data.time[0]) / model_dt + 1
+    with np.errstate(over="ignore"):  # a model sample time of 1e-310 s: inf samples, said below
+        count = (data.time[-1] - data.time[0]) / model_dt + 1
     if not count <= MAX_RESAMPLED:
         raise DataError(f"--resample: the record spans {data.time[-1] - data.time[0]:.6g} s, {count:.3g} samples at the "
                         f"model's {model_dt:.6g} s (at most {MAX_RESAMPLED:.0e}); is the time column in seconds?")
