@@ -108,6 +108,7 @@ def workspace(tmp_path_factory):
         "twotime.csv": "time,t_s,u1,u2,y\n" + "".join(f"12:00:{i:02d},{i * 0.1},{i % 4},{i % 3},{i % 5}\n"
                                                       for i in range(40)),
         "bigtime.csv": "time_s,u1,u2,y\n" + "".join(f"{i * 1e6},{i % 4},{i % 3},{i % 5}\n" for i in range(40)),
+        "flat_output.csv": "u1,u2,y\n" + "".join(f"{i % 4},{i % 3},2.5\n" for i in range(40)),
     }
     for name, text in files.items():
         if text is not None:
@@ -180,6 +181,8 @@ CASES = [
     (["identify", f"{W}/data.csv", *FIT, "--na", "2", "--nb", "2", "--hyperplane", "1,0,0", "--regions", "5",
       "--out", f"{W}/m.json"], "--regions 5: 1 --hyperplane make 2 regions"),
     (["validate", f"{W}/model.json", f"{W}/bigtime.csv", "--resample"], "--resample: the record spans"),
+    (["validate", f"{W}/model.json", f"{W}/flat_output.csv"], "flat_output.csv': the output 'y' is constant (2.5)"),
+    (["residuals", f"{W}/model.json", f"{W}/data.csv", "--lags", "500"], "--lags 500: expected at most"),
     (["validate", f"{W}/model.json", f"{W}/data.csv", "extra\nline"], "unrecognized arguments: extra\\nline"),
     (["identify", f"{W}/data.csv", "--input", "u1", "--output", "", "--na", "1", "--nb", "1", "--out", f"{W}/m.json"],
      "--output: expected a column name, got an empty one"),

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from hwpts.commands._args import json_text
-from hwpts.errors import ParameterError
+from hwpts.errors import DataError, ParameterError
 
 
 def cmd_residuals(args) -> int:
@@ -13,7 +13,12 @@ def cmd_residuals(args) -> int:
 
     model, data = _model_and_data(args)
     model.structure_.check_length(data.n_samples)
-    analysis = residual_analysis(model, data.inputs, data.output, lags=args.lags, confidence=args.confidence)
+    try:
+        analysis = residual_analysis(model, data.inputs, data.output, lags=args.lags, confidence=args.confidence)
+    except DataError as error:
+        if str(error).startswith("lags "):  # said as the option
+            raise DataError(f"--{error}") from None
+        raise
     result = analysis.to_dict()
     if args.plot is not None:
         from hwpts.io.atomic import write_bytes_atomic

@@ -751,6 +751,11 @@ def _model_and_data(args):
 def cmd_validate(args) -> int:
     """``hwpts validate``: free-run and one-step fit of MODEL on DATA (text or JSON), optionally a figure."""
     model, data = _model_and_data(args)
+    m = model.structure_.max_lag
+    if data.n_samples > m and np.ptp(data.output[m:]) == 0:
+        raise DataError(f"{_selection(args, repr(str(args.data)))}: the output {data.output_name!r} is constant "
+                        f"({data.output[m]:.6g}) after the {m} initial conditions; fit % is undefined there "
+                        f"(`hwpts predict` simulates the model on these data)")
     result = _validate_numbers(model, data)
     if args.plot is not None:
         _write_validation_plot(model, data, result, args)

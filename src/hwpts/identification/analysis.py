@@ -168,7 +168,8 @@ def residual_analysis(model, inputs, output, lags: int = 25, confidence: float =
     y = np.asarray(output, dtype=float).ravel()
     e = y[m:] - yhat[m:]
     if e.shape[0] <= lags + 1:
-        raise DataError(f"{e.shape[0]} residuals are too few for {lags} lags; use fewer lags or more data")
+        raise DataError(f"lags {lags}: expected at most {max(e.shape[0] - 2, 0)} for {e.shape[0]} residuals, "
+                        f"got {lags}; use fewer lags or more data")
     u = np.asarray(inputs, dtype=float).reshape(y.shape[0], -1)[m:]
     band = float(norm.ppf(0.5 + float(confidence) / 2) / np.sqrt(e.shape[0]))
     cross = {name: correlation(e, u[:, j], lags) for j, name in enumerate(model.structure_.input_names)}
