@@ -183,6 +183,8 @@ CASES = [
     (["validate", f"{W}/model.json", f"{W}/bigtime.csv", "--resample"], "--resample: the record spans"),
     (["validate", f"{W}/model.json", f"{W}/flat_output.csv"], "flat_output.csv': the output 'y' is constant (2.5)"),
     (["residuals", f"{W}/model.json", f"{W}/data.csv", "--lags", "500"], "--lags 500: expected at most"),
+    (["identify", f"{W}/data.csv", *FIT, "--na", "300", "--out", f"{W}/m.json"],
+     "--na 300: expected orders whose largest lag is below 190 for the 400 samples"),
     (["validate", f"{W}/model.json", f"{W}/data.csv", "extra\nline"], "unrecognized arguments: extra\\nline"),
     (["identify", f"{W}/data.csv", "--input", "u1", "--output", "", "--na", "1", "--nb", "1", "--out", f"{W}/m.json"],
      "--output: expected a column name, got an empty one"),

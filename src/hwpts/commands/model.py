@@ -409,6 +409,37 @@ def _orders_to_search(args):
     return fixed, searched
 
 
+def _largest_lag(grid: dict) -> int:
+    """The largest lag of the orders of ``grid`` (lists of candidates per order key)."""
+    import itertools
+
+    lags = []
+    for na, nb, nk in itertools.product(grid["output_order"], grid["input_order"], grid["input_delay"]):
+        nbs, nks = np.atleast_1d(nb), np.atleast_1d(nk)
+        lags.append(max([int(na)] + [int(b) + int(k) - 1 for b, k in zip(*np.broadcast_arrays(nbs, nks))]))
+    return max(lags)
+
+
+def _check_fixed_lags(fixed, searched, n_samples, name) -> None:
+    """Orders given (``--na``...) whose lags leave the record too short for the model search that
+    chooses the others (2 held-out blocks of the lags plus MIN_BLOCK samples) are said as those
+    options (the search's message asked for the settings the user had given)."""
+    from hwpts.identification.selection.search import MIN_BLOCK, ORDER_GRID
+
+    lag = _largest_lag({k: [fixed[k]] if k in fixed else list(searched[k]) for k in ORDER_GRID})
+    if n_samples // (MIN_BLOCK + lag) >= 2:
+        return
+    alone = _largest_lag({k: list(searched[k]) if k in searched else list(ORDER_GRID[k]) for k in ORDER_GRID})
+    if n_samples // (MIN_BLOCK + alone) < 2:
+        return  # too short whatever the orders: the search says so
+    flags = {"output_order": "--na", "input_order": "--nb", "input_delay": "--nk"}
+    given = " ".join(f"{flags[k]} {','.join(str(v) for v in np.atleast_1d(fixed[k]))}" for k in ORDER_GRID if k in fixed)
+    raise ParameterError(f"{given}: expected orders whose largest lag is below {n_samples // 2 - MIN_BLOCK} for the "
+                         f"{n_samples} samples of {name} (the search that chooses the other orders holds out 2 "
+                         f"blocks of the lags + {MIN_BLOCK} samples and fits each candidate on the rest), got a "
+                         f"largest lag of {lag}; give smaller orders, or every order")
+
+
 def _check_region_count(n_regions, n_samples, fixed, searched, n_inputs, searching, powers=()) -> None:
     """``--regions S`` leaves every region ``ROWS_PER_PARAMETER`` rows a parameter of the smallest
     candidate model (the orders given, else the smallest of the search's grid), in the rows each
@@ -511,6 +542,8 @@ def cmd_identify(args) -> int:
 
         delays = estimate_delays(data.inputs, data.output)
         searched["input_delay"] = delay_candidates(delays)
+    if searched and fixed:
+        _check_fixed_lags(fixed, searched, data.n_samples, _selection(args, repr(str(args.data))))
     # after the delays: "u(k-5)" names a column then; a power term is a column when --output-powers gives it
     _check_partition_columns(args, fixed, searched, given_powers)
     if not searched:
