@@ -432,3 +432,18 @@ def test_the_suite_is_large_enough():
     commands = {a[0] if a and a[0] not in ("plant", "control") else " ".join(a[:2]) for a, _ in CASES if a}
     assert {"identify", "validate", "predict", "residuals", "export", "reproduce", "plant steady-state",
             "plant sweep", "plant simulate", "control run", "control study"} <= commands
+
+
+def test_the_time_column_hint_comes_only_with_errors_about_time(tmp_path, capsys):
+    """The hint that a column was taken as the time axis by its name belongs to errors about the
+    time axis; it was appended to an error about a signal's value as well."""
+    path = tmp_path / "big.csv"
+    path.write_text("time_s,u,y\n" + "".join(f"{k * 0.01},{k % 3},{1e200 if k == 4 else k % 5}\n" for k in range(40)))
+    assert main(["identify", str(path), "--input", "u", "--output", "y", "--na", "1", "--nb", "1",
+                 "--out", str(tmp_path / "m.json")]) == 2
+    err = capsys.readouterr().err
+    assert "column 'y' has the value 1e+200 at row 4" in err and "time column" not in err
+    path.write_text("time_s,u,y\n" + "".join(f"{(40 - k) * 0.01},{k % 3},{k % 5}\n" for k in range(40)))
+    assert main(["identify", str(path), "--input", "u", "--output", "y", "--na", "1", "--nb", "1",
+                 "--out", str(tmp_path / "m.json")]) == 2
+    assert "'time_s' is taken as the time column by its name" in capsys.readouterr().err

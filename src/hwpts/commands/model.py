@@ -156,8 +156,9 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
         tname = "__index__"
     try:
         data = IODataset.from_columns(cols, list(input_names), output_name, time_name=tname)
-    except DataError as error:
-        raise DataError(f"{str(path)!r}: {error}{hint}") from None
+    except DataError as error:  # the hint where the time column is what the error is about
+        about_time = str(error).startswith("time ") or repr(tname) in str(error) or "'time'" in str(error)
+        raise DataError(f"{str(path)!r}: {error}{hint if about_time else ''}") from None
     try:
         dt = _sample_time(data, path, tname) if timed else None
     except DataError as error:
