@@ -717,3 +717,27 @@ def test_a_fixed_count_is_chosen_even_where_one_arx_model_scores_better(monkeypa
             PWARXSearch(PWARX(1, 1, 1), n_regions=bad).fit(u, y)
     with pytest.raises(ParameterError, match=r"with a param_grid give the counts in the grid"):
         PWARXSearch(PWARX(1, 1, 1), param_grid={"n_regions": [2, 3]}, n_regions=3).fit(u, y)
+
+
+def test_a_fixed_count_carries_the_orders_that_can_hold_it(monkeypatch):
+    """With a fixed count the carried orders are those whose local models that many regions can
+    hold (3 rows a parameter), topped up from the ARX ranking: ``--regions 26`` on 300 rows carried
+    three orders none of which could hold 26 regions, and every candidate failed, where the
+    smallest order could. Made-up scores: the ARX models better the larger their orders."""
+    from hwpts.identification.selection import search as S
+
+    def scored(estimator, params, u, y, splits, prune_below=-np.inf, names=None, output_name=None, leader=None,
+               one_step=False, best_row=None):
+        size = params.get("output_order", 0) + params.get("input_order", 0)
+        free = 50.0 + size if params["segmentation"] == "average" else 70.0
+        return made_up_row(params, splits, free, free + 10)
+
+    monkeypatch.setattr(S, "_evaluate", scored)
+    u, y = setar(600, 0)
+    search = PWARXSearch(PWARX(random_state=0), orders="auto", n_regions=30, try_polish=False, shared_modes=False,
+                         output_powers=None, refit_margin=1000.0)
+    search.fit(u, y)
+    raced = [r["params"] for r in search.cv_results_ if r["params"]["segmentation"] != "average"]
+    splits = search._splits(600, 5)
+    assert raced and all(search._room(PWARX(), p, u, splits) >= 30 for p in raced)
+    assert search.best_params_["n_regions"] == 30

@@ -648,7 +648,18 @@ class PWARXSearch(BaseEstimator):
             ranked = sorted(rows, key=lambda r: -self._score(r))
             keep = [{k: r["params"][k] for k in ORDER_KEYS if k in r["params"]} for r in ranked
                     if np.isfinite(self._score(r))]
+            ranked_orders = keep
             keep = self._carried_orders(base, keep, rows, u, y, splits)
+            fixed = self._fixed()
+            if fixed is not None and fixed >= 2:
+                # a fixed count: the carried orders whose local models that many regions can hold
+                # (3 rows a parameter), topped up from the ARX ranking (--regions 26 on 300 rows: the
+                # three carried orders could not hold 26 regions and every candidate failed, where
+                # the smallest order can)
+                room = [o for o in [*keep, *ranked_orders] if self._room(base, o, u, splits) >= fixed]
+                room = [o for i, o in enumerate(room) if o not in room[:i]]
+                if room:
+                    keep = room[:max(1, int(self.n_orders))]
             if not keep:
                 errors = sorted({r["error"] for r in rows if r["error"]})
                 if len(errors) == 1 and all(r["error"] for r in rows):  # one cause, whatever the order
