@@ -149,7 +149,7 @@ def simulate_command(args) -> int:
             if missing:
                 raise DataError(f"missing column(s) {missing}; available columns are {sorted(columns)}")
             dataset, _ = bed.run(columns["time_s"], columns["valve_voltage_v"], columns["pump_speed_rpm"],
-                                 seed=args.seed)
+                                 seed=args.seed, progress=True)
         except (DataError, SimulationError) as error:
             raise type(error)(f"--inputs {args.inputs!r}: {error}") from None
     write_table(args.out, dataset.columns())

@@ -35,6 +35,7 @@ _NZ = N_STATES + 1  # the 5 states + the spool position
 # signal handlers (a profile of 10^6 s in one call ignored Ctrl-C and SIGTERM until it ended)
 CHUNK = 2000
 LONG_HOLD = 10.0
+PROGRESS_AFTER = 600.0  # simulated seconds beyond which ``progress=True`` shows a bar (10 min of the rig: ~10 s here)
 
 DEFAULT_RTOL = 1e-5
 DEFAULT_ATOL = (50.0, 50.0, 50.0, 1e-3, 1e-3, 1e-9)
@@ -273,6 +274,7 @@ def simulate_plant(
     valve_initial=None,
     rtol: float = DEFAULT_RTOL,
     max_step: float = 0.05,
+    progress: bool = False,
 ) -> PlantResponse:
     """Simulate the plant over the sample grid ``time`` [s] with zero-order-hold inputs.
 
@@ -295,6 +297,9 @@ def simulate_plant(
         Relative tolerance of the step control.
     max_step : float
         Longest integration step [s].
+    progress : bool
+        A progress bar (simulated seconds) on a terminal, for a profile longer than
+        :data:`PROGRESS_AFTER` seconds.
 
     Raises
     ------
@@ -333,17 +338,23 @@ def simulate_plant(
     stats = np.zeros(4, dtype=np.int64)
     atol = np.array(DEFAULT_ATOL)
     hstate = np.array([min(1e-3, float(max_step))])
-    for a in range(0, grid.size - 1, CHUNK):
-        b = min(a + CHUNK, grid.size - 1)
-        failed = _integrate(grid[a:b + 1], h_grid[a:b + 1], wp_grid[a:b + 1], p, out_grid[a].copy(), float(rtol),
-                            atol, float(max_step), out_grid[a:b + 1], stats, hstate)
-        if failed >= 0:
-            k = int(source[a + failed])
-            raise SimulationError(
-                f"integration failed between t = {t[k]:.6g} s and {t[k + 1]:.6g} s "
-                f"(step size underflow or non-finite state after {stats[0]} steps); "
-                "check the parameters and inputs, or lower rtol"
-            )
+    from tqdm import tqdm
+
+    show = progress and t[-1] - t[0] > PROGRESS_AFTER
+    with tqdm(total=round(float(t[-1] - t[0]), 2), desc="plant simulation", unit="s", leave=False,
+              disable=None if show else True) as bar:
+        for a in range(0, grid.size - 1, CHUNK):
+            b = min(a + CHUNK, grid.size - 1)
+            failed = _integrate(grid[a:b + 1], h_grid[a:b + 1], wp_grid[a:b + 1], p, out_grid[a].copy(),
+                                float(rtol), atol, float(max_step), out_grid[a:b + 1], stats, hstate)
+            if failed >= 0:
+                k = int(source[a + failed])
+                raise SimulationError(
+                    f"integration failed between t = {t[k]:.6g} s and {t[k + 1]:.6g} s "
+                    f"(step size underflow or non-finite state after {stats[0]} steps); "
+                    "check the parameters and inputs, or lower rtol"
+                )
+            bar.update(round(float(grid[b] - grid[a]), 2))
     out = out_grid[np.searchsorted(grid, t)] if grid.size != t.size else out_grid
     state = out[:, :N_STATES]
     wp_actual = pump_speed_actual.py_func(state[:, 0], wp_cmd, p)
