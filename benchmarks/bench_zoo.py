@@ -22,6 +22,10 @@ an autoregressive part) is reported with its spread; region accuracy where modes
 matching of estimated to true regions). Systems without true parameters (function
 approximations) have no oracle row: PyPARC is their reference.
 
+``--told-regions``: one more line per system, ``hwpts, K told``: the same search told the true
+number of regions, as PyPARC is (``PWARXSearch(..., n_regions=K)``, ``hwpts identify --regions K``:
+the method still chosen), its one-step fit, region accuracy, time and free run.
+
 ``--variants``: instead of the zoo's systems, its ``pwarx_random`` generator with other settings
 (:data:`VARIANTS`: other instances, orders, numbers of modes, partitions, noise, and modes sharing
 parameters), the systems the default was not tuned on.
@@ -30,7 +34,7 @@ parameters), the systems the default was not tuned on.
 na 2, nb 2) with these numbers of training samples, the zoo's "N from 1e4 to 1e6" (with
 ``--seeds=1 --no-peers`` at a million samples: the search takes minutes there, PyPARC far longer).
 
-``python -m benchmarks zoo [--seeds=N] [--systems=a,b] [--variants | --sizes=N,N] [--no-peers]`` (with
+``python -m benchmarks zoo [--seeds=N] [--systems=a,b] [--variants | --sizes=N,N] [--told-regions] [--no-peers]`` (with
 ``--variants``, ``--systems`` names variants)
 """
 
@@ -87,15 +91,15 @@ def validation_n(d):
     return 3000 if d.kind == "pwarx" else 2000
 
 
-def hwpts_default(na, nb, nk, u, y, seed):
-    """What a user gets without choosing anything but the orders."""
+def hwpts_default(na, nb, nk, u, y, seed, n_regions="auto"):
+    """What a user gets without choosing anything but the orders (and, told, the number of regions)."""
     from hwpts.identification import PWARX
 
     try:
         from hwpts.identification import PWARXSearch
     except ImportError:  # before the model search existed: the CLI's default
         return PWARX(na, nb, nk, segmentation="auto", random_state=seed).fit(u, y)
-    search = PWARXSearch(PWARX(output_order=na, input_order=nb, input_delay=nk, random_state=seed))
+    search = PWARXSearch(PWARX(output_order=na, input_order=nb, input_delay=nk, random_state=seed), n_regions=n_regions)
     return search.fit(u, y).best_estimator_
 
 
@@ -125,9 +129,9 @@ def one_step_fit(y, yhat):
     return 100.0 * (1.0 - np.linalg.norm(y - yhat) / np.linalg.norm(y - y.mean()))
 
 
-def run_system(zoo, name, seeds, pyparc_py, progress=None, kw=None):
+def run_system(zoo, name, seeds, pyparc_py, progress=None, kw=None, told=False):
     """Rows of every estimator on ``name``'s data sets; ``kw``: the generator's settings (default:
-    the zoo's, N = 20,000 for ``pwarx_random``)."""
+    the zoo's, N = 20,000 for ``pwarx_random``); ``told``: also the search told the number of regions."""
     from hwpts.identification import region_accuracy
 
     gen, meta = zoo.SYSTEMS[name]
@@ -135,7 +139,7 @@ def run_system(zoo, name, seeds, pyparc_py, progress=None, kw=None):
         kw = {"n": 20000} if name == "pwarx_random" else {}
     same = {k: v for k, v in kw.items() if k not in ("n", "sigma")}  # the instance, validated noise-free
     rows = {k: {"onestep": [], "freerun": [], "regions": [], "time": [], "n_regions": []}
-            for k in ("oracle", "modes", "arx", "hwpts", "pyparc")}
+            for k in ("oracle", "modes", "arx", "hwpts", "told", "pyparc")}
     notes = []
     for seed in seeds:
         d = gen(rng=seed, **kw)
@@ -168,7 +172,7 @@ def run_system(zoo, name, seeds, pyparc_py, progress=None, kw=None):
             yhat = np.einsum("ij,ij->i", np.column_stack([Phi_v, np.ones(len(Phi_v))]), th[reg])
             rows["modes"]["onestep"].append(one_step_fit(Y_v[ok_v], yhat[ok_v]))
 
-        for key in ("arx", "hwpts"):
+        for key in ("arx", "hwpts", *(("told",) if told else ())):
             t0 = time.perf_counter()
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
@@ -176,7 +180,8 @@ def run_system(zoo, name, seeds, pyparc_py, progress=None, kw=None):
                     if key == "arx":
                         model = PWARX(na, nb, nk, n_regions=1, segmentation="average").fit(u, d.output)
                     else:
-                        model = hwpts_default(na, nb, nk, u, d.output, seed)
+                        model = hwpts_default(na, nb, nk, u, d.output, seed,
+                                              d.n_modes if key == "told" else "auto")
                 except Exception as error:  # noqa: BLE001 - a benchmark reports, it does not stop
                     notes.append(f"{key} seed {seed}: {type(error).__name__}: {error}")
                     continue
@@ -194,7 +199,7 @@ def run_system(zoo, name, seeds, pyparc_py, progress=None, kw=None):
                 if dynamic:
                     sim = model.simulate(uv, v.output)
                     rows[key]["freerun"].append(np.nan if sim.diverged else one_step_fit(v.output[m:], sim.output[m:]))
-                if d.theta is not None and key == "hwpts":
+                if d.theta is not None and key in ("hwpts", "told"):
                     regions = model.predict_regions(uv, v.output)[mm:]
                     rows[key]["regions"].append(100 * region_accuracy(M_v[ok_v], regions[ok_v]))
         # pyparc
@@ -301,7 +306,7 @@ def main(argv=None) -> int:
     failures = []
     summary = {}
     for name, system, kw in runs:
-        rows, notes = run_system(zoo, system, seeds, pyparc_py, kw=kw)
+        rows, notes = run_system(zoo, system, seeds, pyparc_py, kw=kw, told="--told-regions" in argv)
         ref = zoo.REFERENCE.get(system, {}) if kw is None else {"generator": system, **kw}
         oracle = _med(rows["oracle"]["onestep"])
         hw = _med(rows["hwpts"]["onestep"])
@@ -322,6 +327,11 @@ def main(argv=None) -> int:
         print(f"{name:15s} {oracle:>7s} {_med(rows['modes']['onestep']):>6s} {_med(rows['arx']['onestep']):>6s} {hw:>6s} {pp:>6s} {gap:>6s} "
               f"{nreg:>7s} {_med(rows['hwpts']['regions']):>6s} {_med(rows['pyparc']['regions']):>6s} "
               f"{_med(rows['hwpts']['time'], '.2f'):>7s} {_med(rows['pyparc']['time'], '.2f'):>6s}  {fr}", flush=True)
+        if rows["told"]["onestep"]:
+            fr = _spread(rows["told"]["freerun"]) if rows["told"]["freerun"] else ""
+            print(f"{'  K told':15s} {'':>7s} {'':>6s} {'':>6s} {_med(rows['told']['onestep']):>6s} {'':>6s} {'':>6s} "
+                  f"{_med(rows['told']['n_regions'], '.0f'):>7s} {_med(rows['told']['regions']):>6s} {'':>6s} "
+                  f"{_med(rows['told']['time'], '.2f'):>7s} {'':>6s}  {fr}", flush=True)
         for note in notes[:3]:
             print(f"    note: {note}")
         if len(notes) > 3:
