@@ -168,15 +168,16 @@ def _run(argv: Sequence[str] | None) -> int:
             _INTERRUPTED_FRAMES.append(error)
             written = _written_since(args, before)
             # a stop that lands after an output was committed cannot undo it: say so
-            print("hwpts: interrupted" + (f" after writing {', '.join(written)}" if written else ""), file=sys.stderr)
+            print(_one_line("hwpts: interrupted" + (f" after writing {', '.join(written)}" if written else "")),
+                  file=sys.stderr)
             return 130
         if _stdout_failed(error):
             # the report printed after the outputs were committed (a full disk behind stdout): the
             # line names the stream, and the files that are complete all the same
             written = _written_since(args, before)
-            print(f"hwpts: error: standard output: cannot write ({error.strerror or error})"
-                  + (f"; {', '.join(written)} {'was' if len(written) == 1 else 'were'} written in full"
-                     if written else ""), file=sys.stderr)
+            print(_one_line(f"hwpts: error: standard output: cannot write ({error.strerror or error})"
+                            + (f"; {', '.join(written)} {'was' if len(written) == 1 else 'were'} written in full"
+                               if written else "")), file=sys.stderr)
             return EXIT_USAGE
         return _report(error)
     return status

@@ -346,6 +346,17 @@ def test_regions_given_method_auto_chooses_among_the_default_methods(tmp_path, d
     assert json.loads(capsys.readouterr().out)["segmentation"] == "average"
 
 
+def test_zero_region_with_a_count_and_the_orders_open(tmp_path, data_csv, capsys):
+    """--zero-region numbers regions of the count given: every candidate has that count (a grid),
+    not the adaptive search's single ARX models, which failed on the zero modes' count."""
+    out = tmp_path / "z.json"
+    assert main(["identify", str(data_csv), "--input", "u1", "--input", "u2", "--output", "y", "--nk", "1",
+                 "--regions", "2", "--zero-region", "2", "--out", str(out)]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["n_regions"] == 2 and summary["choice"]["scoring"] == "free-run"
+    assert {r["n_regions"] for r in summary["candidates"]} == {2}
+
+
 def test_hyperplane_with_a_negative_first_coefficient(tmp_path, data_csv, capsys):
     """The documented form for a negative first coefficient: --hyperplane=-1,0,0.2."""
     out = tmp_path / "m.json"

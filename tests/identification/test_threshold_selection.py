@@ -741,3 +741,17 @@ def test_a_fixed_count_carries_the_orders_that_can_hold_it(monkeypatch):
     splits = search._splits(600, 5)
     assert raced and all(search._room(PWARX(), p, u, splits) >= 30 for p in raced)
     assert search.best_params_["n_regions"] == 30
+
+
+def test_a_fixed_count_prefers_the_models_that_kept_every_region():
+    """Among the candidates the best does not beat, a fixed count puts those whose fits kept all
+    of its regions first (a learned segmentation may drop some); the ARX rows only ranked the orders."""
+    search = PWARXSearch(PWARX(1, 1, 1), n_regions=3)
+    search.scoring_ = "free_run"
+    splits = [(None, None)] * 5
+    arx = made_up_row({"segmentation": "average", "n_regions": 1}, splits, 90.0, 95.0)
+    dropped = made_up_row({"segmentation": "alternating", "n_regions": 3}, splits, 80.2, 90.0)
+    dropped["n_regions_fitted"] = 2
+    kept = made_up_row({"segmentation": "threshold", "n_regions": 3}, splits, 80.0, 90.0)
+    order = search._preference(PWARX(1, 1, 1), [arx, dropped, kept], np.zeros((10, 1)))
+    assert order == [kept, dropped]

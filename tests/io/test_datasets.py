@@ -106,6 +106,10 @@ def test_a_blank_line_between_data_rows_is_refused_with_its_line(tmp_path, gap, 
     path.write_text(f"u,y{tail}\n1,2{tail}\n3,4{tail}\n{gap}5,6{tail}\n")
     with pytest.raises(DataError, match=r"line 4: expected a data row, got a blank line between data rows"):
         read_table(path)
+    for end in ("\r", "\r\n"):  # old Mac line ends (pyarrow read them past the check), Windows'
+        path.write_bytes(f"u,y{tail}{end}1,2{tail}{end}3,4{tail}{end}{end}5,6{tail}{end}".encode())
+        with pytest.raises(DataError, match=r"line 4: expected a data row, got a blank line between data rows"):
+            read_table(path)
 
 
 @pytest.mark.parametrize("text", [

@@ -405,6 +405,9 @@ def _orders_to_search(args):
         values = given[key] if isinstance(given[key], list) else [given[key]]
         if given[key] is not None and any(v < 0 for v in values):
             raise ParameterError(f"{flag} expects ints >= 0, got {given[key]!r}")
+        if isinstance(given[key], list) and len(given[key]) not in (1, len(args.input)):
+            raise ParameterError(f"{flag} expects one value or one per input ({len(args.input)}: "
+                                 f"{','.join(args.input)}), got {len(given[key])}: {','.join(map(str, given[key]))}")
     searched = {k: list(ORDER_GRID[k]) for k, v in given.items() if v is None}
     fixed = {k: v for k, v in given.items() if v is not None}
     return fixed, searched
@@ -417,6 +420,8 @@ def _largest_lag(grid: dict) -> int:
     lags = []
     for na, nb, nk in itertools.product(grid["output_order"], grid["input_order"], grid["input_delay"]):
         nbs, nks = np.atleast_1d(nb), np.atleast_1d(nk)
+        if nbs.size != nks.size and 1 not in (nbs.size, nks.size):
+            return None  # one per input, of other lengths: refused where the model is built
         lags.append(max([int(na)] + [int(b) + int(k) - 1 for b, k in zip(*np.broadcast_arrays(nbs, nks))]))
     return max(lags)
 
@@ -428,14 +433,14 @@ def _check_fixed_lags(fixed, searched, n_samples, name) -> None:
     from hwpts.identification.selection.search import MIN_BLOCK, ORDER_GRID
 
     lag = _largest_lag({k: [fixed[k]] if k in fixed else list(searched[k]) for k in ORDER_GRID})
-    if n_samples // (MIN_BLOCK + lag) >= 2:
+    if lag is None or n_samples // (MIN_BLOCK + lag) >= 2:
         return
     alone = _largest_lag({k: list(searched[k]) if k in searched else list(ORDER_GRID[k]) for k in ORDER_GRID})
-    if n_samples // (MIN_BLOCK + alone) < 2:
+    if alone is None or n_samples // (MIN_BLOCK + alone) < 2:
         return  # too short whatever the orders: the search says so
     flags = {"output_order": "--na", "input_order": "--nb", "input_delay": "--nk"}
     given = " ".join(f"{flags[k]} {','.join(str(v) for v in np.atleast_1d(fixed[k]))}" for k in ORDER_GRID if k in fixed)
-    raise ParameterError(f"{given}: expected orders whose largest lag is below {n_samples // 2 - MIN_BLOCK} for the "
+    raise ParameterError(f"{given}: expected orders whose largest lag is at most {n_samples // 2 - MIN_BLOCK} for the "
                          f"{n_samples} samples of {name} (the search that chooses the other orders holds out 2 "
                          f"blocks of the lags + {MIN_BLOCK} samples and fits each candidate on the rest), got a "
                          f"largest lag of {lag}; give smaller orders, or every order")
@@ -521,6 +526,7 @@ def cmd_identify(args) -> int:
     from hwpts.identification.regressors import RegressorStructure
     from hwpts.identification.selection import DEFAULT_METHODS
     from hwpts.identification.segmentation import SEGMENTATION_METHODS
+    from hwpts.identification.selection.search import METHOD_PARAMS
     from hwpts.io.models import save_model
 
     _check_signals(args.input, args.output)
@@ -543,8 +549,6 @@ def cmd_identify(args) -> int:
 
         delays = estimate_delays(data.inputs, data.output)
         searched["input_delay"] = delay_candidates(delays)
-    if searched and fixed:
-        _check_fixed_lags(fixed, searched, data.n_samples, _selection(args, repr(str(args.data))))
     # after the delays: "u(k-5)" names a column then; a power term is a column when --output-powers gives it
     _check_partition_columns(args, fixed, searched, given_powers)
     if not searched:
@@ -581,6 +585,9 @@ def cmd_identify(args) -> int:
         raise ParameterError(f"--regions {n_regions}: expected at most {int(np.ceil(1 / share)) - 1} for "
                              f"--segmentation {segmentation} (a threshold split leaves each region at least "
                              f"{100 * share:g} % of the rows), got {n_regions}")
+    if segmentation not in ("hyperplane", "average", "zscore") and searched and fixed:
+        # (a fixed partition's grid search splits by the given orders' lags alone)
+        _check_fixed_lags(fixed, searched, data.n_samples, _selection(args, repr(str(args.data))))
     if segmentation not in ("hyperplane", "average", "zscore"):
         _check_region_count(n_regions, data.n_samples, fixed, searched, len(args.input),
                             searching=bool(searched) or segmentation == "auto",
@@ -613,6 +620,14 @@ def cmd_identify(args) -> int:
         if searched:
             search = PWARXSearch(model, param_grid=dict(searched), progress=True,
                                  try_polish=try_polish)
+    elif region_models is not None and isinstance(n_regions, int) and (searched or segmentation == "auto"):
+        # --zero-region: every candidate has the S regions the zero modes are numbered in (the
+        # adaptive search's ARX models have one), so a grid at that count: each default method, or
+        # the one given, with the orders left open
+        chosen = DEFAULT_METHODS if segmentation == "auto" else (segmentation,)
+        grid = [{**searched, "segmentation": [m], "n_regions": [n_regions],
+                 "segmentation_params": [METHOD_PARAMS.get(m)]} for m in chosen]
+        search = PWARXSearch(model, param_grid=grid, progress=True, try_polish=try_polish)
     elif searched or (n_regions == "auto" and not fixed_partition) or (segmentation == "auto"
                                                                       and isinstance(n_regions, int)):
         if segmentation == "auto" or not fixed_partition:

@@ -115,7 +115,8 @@ def read_csv(path: str | os.PathLike, columns=None) -> dict[str, np.ndarray]:
     return out
 
 
-_BLANK_INSIDE = re.compile(rb"\n[ \t\r\f\v]*\n[ \t\r\n\f\v]*[^ \t\r\n\f\v]")
+_EOL = rb"(?:\r\n|\n|\r(?!\n))"  # a line end: CRLF, LF, or a lone CR (old Mac files)
+_BLANK_INSIDE = re.compile(_EOL + rb"[ \t\f\v]*" + _EOL + rb"\s*\S")
 
 
 def _blank_line_inside(p: Path) -> bool:

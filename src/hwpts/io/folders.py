@@ -107,6 +107,9 @@ def staged_folder(path: str | os.PathLike, schema: str):
             (stage / PID_FILE).unlink()
             (stage / MANIFEST).write_text(json.dumps(sorted(_files(stage))), encoding="utf-8")
             os.chmod(stage, umask_mode(0o777))
+        except OSError as error:  # a full disk at the last file: said as the folder, not as stdout
+            shutil.rmtree(stage, ignore_errors=True)
+            raise DataError(f"--out {str(out)!r}: cannot write there ({error.strerror or error})") from None
         except BaseException:
             shutil.rmtree(stage, ignore_errors=True)
             raise

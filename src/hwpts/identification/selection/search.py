@@ -1107,7 +1107,9 @@ class PWARXSearch(BaseEstimator):
         # the output powers after every affine model: they must beat the affine pieces, as the
         # polish must beat the model it polishes (a cubic and a few pieces can tie on the blocks
         # and part beyond the training range, where the cubic bends away)
-        near.sort(key=lambda r: (bool(r["params"].get("output_powers")), r["n_regions_fitted"] or 1,
+        # (a fixed count: the models that kept every region first, then as many as fit)
+        near.sort(key=lambda r: (bool(r["params"].get("output_powers")),
+                                 (r["n_regions_fitted"] or 1) != fixed if fixed is not None else r["n_regions_fitted"] or 1,
                                  self._n_params(base, r["params"], u.shape[1]), -self._score(r)))
         rest = sorted((r for r in ok if r not in near), key=lambda r: -self._score(r))
         return near + rest
