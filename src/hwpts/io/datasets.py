@@ -53,14 +53,16 @@ def read_table(path: str | os.PathLike, columns=None) -> dict[str, np.ndarray]:
 DELIMITERS = (",", ";", "\t")
 
 
-def _sniff(p: Path) -> str:
-    """The delimiter of the header line: the most frequent of comma, semicolon and tab."""
-    try:
-        with p.open("rb") as f:
-            head = f.read(65536)
-    except OSError as error:
-        raise DataError(f"{str(p)!r}: cannot read ({error.strerror or error})") from None
-    text = head.decode("utf-8-sig", errors="replace")
+def _sniff(p: Path, head: bytes | None = None) -> str:
+    """The delimiter of the header line (in ``head``, the file's first bytes, read when not given):
+    the most frequent of comma, semicolon and tab."""
+    if head is None:
+        try:
+            with p.open("rb") as f:
+                head = f.read(65536)
+        except OSError as error:
+            raise DataError(f"{str(p)!r}: cannot read ({error.strerror or error})") from None
+    text = head[:65536].decode("utf-8-sig", errors="replace")
     first = next((line for line in text.splitlines() if line.strip()), "")
     counts = {d: first.count(d) for d in DELIMITERS}
     best = max(counts, key=counts.get)
@@ -79,15 +81,17 @@ def read_csv(path: str | os.PathLike, columns=None) -> dict[str, np.ndarray]:
     import pyarrow.csv as pacsv
 
     p = Path(path)
-    delimiter = _sniff(p)
-    if _blank_line_inside(p):  # pyarrow skips it: the line-by-line reader refuses one between data rows
-        return _read_csv_python(p, delimiter, columns)
     try:
-        table = pacsv.read_csv(p, parse_options=pacsv.ParseOptions(delimiter=delimiter))
-    except (pa.ArrowInvalid, pa.ArrowTypeError, UnicodeDecodeError):
-        return _read_csv_python(p, delimiter, columns)  # raises the precise error
+        data = p.read_bytes()  # read once: the delimiter, the blank-line check and both parses use it
     except OSError as error:
         raise DataError(f"{str(p)!r}: cannot read ({error.strerror or error})") from None
+    delimiter = _sniff(p, data)
+    if _BLANK_INSIDE.search(data):  # pyarrow skips it: the line-by-line reader refuses one between data rows
+        return _read_csv_python(p, delimiter, columns)
+    try:
+        table = pacsv.read_csv(pa.BufferReader(data), parse_options=pacsv.ParseOptions(delimiter=delimiter))
+    except (pa.ArrowInvalid, pa.ArrowTypeError, UnicodeDecodeError):
+        return _read_csv_python(p, delimiter, columns)  # raises the precise error
     try:
         names = [str(n).strip() for n in table.column_names]
     except UnicodeDecodeError:  # a header that is not UTF-8
@@ -110,31 +114,24 @@ def read_csv(path: str | os.PathLike, columns=None) -> dict[str, np.ndarray]:
         # instead of raising pyarrow's range error; a missing cell is NaN (refused where it is used)
         out[name] = column.cast(pa.float64(), safe=False).to_numpy(zero_copy_only=False)
     integers = [table.column_names[i] for i in wanted if pa.types.is_integer(table.column(i).type)]
-    if integers and _has_hex(p, delimiter, integers):  # pyarrow reads "0x10" as 16; no CSV writer means that
+    if integers and _has_hex(data, delimiter, integers):  # pyarrow reads "0x10" as 16; no CSV writer means that
         return _read_csv_python(p, delimiter, columns)  # refuses the cell, naming its line
     return out
 
 
 _EOL = rb"(?:\r\n|\n|\r(?!\n))"  # a line end: CRLF, LF, or a lone CR (old Mac files)
-_BLANK_INSIDE = re.compile(_EOL + rb"[ \t\f\v]*" + _EOL + rb"\s*\S")
+_BLANK_INSIDE = re.compile(_EOL + rb"[ \t\f\v]*" + _EOL + rb"\s*\S")  # a blank line with text after it
 
 
-def _blank_line_inside(p: Path) -> bool:
-    """Whether the file has a blank (or white) line followed by more text."""
-    try:
-        return _BLANK_INSIDE.search(p.read_bytes()) is not None
-    except OSError:
-        return False  # the reader says why
-
-
-def _has_hex(p: Path, delimiter: str, names: list[str]) -> bool:
-    """Whether a cell of the columns ``names`` (read as integers) was written in hexadecimal."""
+def _has_hex(data: bytes, delimiter: str, names: list[str]) -> bool:
+    """Whether a cell of the columns ``names`` (read as integers) of the CSV ``data`` was written in
+    hexadecimal."""
     import pyarrow as pa
     import pyarrow.compute as pc
     import pyarrow.csv as pacsv
 
     try:
-        text = pacsv.read_csv(p, parse_options=pacsv.ParseOptions(delimiter=delimiter),
+        text = pacsv.read_csv(pa.BufferReader(data), parse_options=pacsv.ParseOptions(delimiter=delimiter),
                               convert_options=pacsv.ConvertOptions(include_columns=names,
                                                                    column_types={n: pa.string() for n in names}))
     except (pa.ArrowInvalid, OSError):
