@@ -312,8 +312,8 @@ def _fit_summary(model, data, path, out, elapsed, search=None, delays=None):
 
 
 def _fixed_count(search) -> bool:
-    """Whether the search was told the number of regions (``--regions S``)."""
-    return search.param_grid is None and not isinstance(search.n_regions, str)
+    """Whether the search was told the number of regions (``--regions S``; never with a grid)."""
+    return search.n_regions != "auto"
 
 
 def _powers_summary(search, model):
@@ -413,30 +413,20 @@ def _orders_to_search(args):
     return fixed, searched
 
 
-def _largest_lag(grid: dict) -> int:
-    """The largest lag of the orders of ``grid`` (lists of candidates per order key)."""
-    import itertools
-
-    lags = []
-    for na, nb, nk in itertools.product(grid["output_order"], grid["input_order"], grid["input_delay"]):
-        nbs, nks = np.atleast_1d(nb), np.atleast_1d(nk)
-        if nbs.size != nks.size and 1 not in (nbs.size, nks.size):
-            return None  # one per input, of other lengths: refused where the model is built
-        lags.append(max([int(na)] + [int(b) + int(k) - 1 for b, k in zip(*np.broadcast_arrays(nbs, nks))]))
-    return max(lags)
-
-
 def _check_fixed_lags(fixed, searched, n_samples, name) -> None:
     """Orders given (``--na``...) whose lags leave the record too short for the model search that
     chooses the others (2 held-out blocks of the lags plus MIN_BLOCK samples) are said as those
     options (the search's message asked for the settings the user had given)."""
-    from hwpts.identification.selection.search import MIN_BLOCK, ORDER_GRID
+    from hwpts.identification import PWARX, PWARXSearch
+    from hwpts.identification.selection.search import MIN_BLOCK, ORDER_GRID, expand_grid
 
-    lag = _largest_lag({k: [fixed[k]] if k in fixed else list(searched[k]) for k in ORDER_GRID})
-    if lag is None or n_samples // (MIN_BLOCK + lag) >= 2:
+    def largest_lag(grid):  # as the search finds it (PWARXSearch.fit: the largest over its order grid)
+        return max(PWARXSearch._max_lag(PWARX(), orders) for orders in expand_grid(grid))
+
+    lag = largest_lag({k: [fixed[k]] if k in fixed else list(searched[k]) for k in ORDER_GRID})
+    if n_samples // (MIN_BLOCK + lag) >= 2:
         return
-    alone = _largest_lag({k: list(searched[k]) if k in searched else list(ORDER_GRID[k]) for k in ORDER_GRID})
-    if alone is None or n_samples // (MIN_BLOCK + alone) < 2:
+    if n_samples // (MIN_BLOCK + largest_lag({k: list(searched.get(k, ORDER_GRID[k])) for k in ORDER_GRID})) < 2:
         return  # too short whatever the orders: the search says so
     flags = {"output_order": "--na", "input_order": "--nb", "input_delay": "--nk"}
     given = " ".join(f"{flags[k]} {','.join(str(v) for v in np.atleast_1d(fixed[k]))}" for k in ORDER_GRID if k in fixed)
