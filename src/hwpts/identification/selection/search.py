@@ -637,6 +637,7 @@ class PWARXSearch(BaseEstimator):
 
     def _adaptive(self, base, order_grid, u, y, splits, bar):
         table = []
+        fixed = self._fixed()
         arx = {"segmentation": "average", "n_regions": 1, "segmentation_params": None}
         if len(order_grid) > 1:
             # with the scoring still open, raced on the free run only once some order's free run
@@ -650,7 +651,6 @@ class PWARXSearch(BaseEstimator):
                     if np.isfinite(self._score(r))]
             ranked_orders = keep
             keep = self._carried_orders(base, keep, rows, u, y, splits)
-            fixed = self._fixed()
             if fixed is not None and fixed >= 2:
                 # a fixed count: the carried orders whose local models that many regions can hold
                 # (3 rows a parameter), topped up from the ARX ranking (--regions 26 on 300 rows: the
@@ -677,7 +677,6 @@ class PWARXSearch(BaseEstimator):
         # raced and it is not raced already (``methods=("threshold",)`` asks for threshold alone)
         names = {getattr(m, "name", m) for m in methods}  # a segmenter instance by its method's name
         refine = {"threshold", "alternating"} <= names and REFINED not in names
-        fixed = self._fixed()
         for number, orders in enumerate(keep):
             best, best_one = self._bests(table, orders)
             top = min(self._room(base, orders, u, splits),
@@ -697,7 +696,7 @@ class PWARXSearch(BaseEstimator):
                           "segmentation_params": METHOD_PARAMS.get(m)} for m in active]
                 # with a fixed count the race is among the models of that count: pruned against an
                 # ARX model they trail, none would be left to choose from
-                pool = table if fixed is None else [r for r in table if (r["params"].get("n_regions") or 1) == fixed]
+                pool = self._at_fixed_count(table)
                 if number == 0:
                     leader = max(pool, key=self._score, default=None)
                 else:
@@ -766,6 +765,11 @@ class PWARXSearch(BaseEstimator):
     def _fixed(self):
         """The number of regions the user fixed (``n_regions``), or ``None``."""
         return None if isinstance(self.n_regions, str) else int(self.n_regions)
+
+    def _at_fixed_count(self, rows) -> list:
+        """The rows with the number of regions the user fixed (``n_regions``); all without one."""
+        fixed = self._fixed()
+        return list(rows) if fixed is None else [r for r in rows if (r["params"].get("n_regions") or 1) == fixed]
 
     def _counts(self, top: int):
         """The region counts the region stage tries for one order: 2 up to ``top`` (the growth rule
@@ -1094,8 +1098,7 @@ class PWARXSearch(BaseEstimator):
         """Candidates in the order they are tried for the refit: those the best does not beat
         (:meth:`_beats`), fewer regions then fewer parameters first; then the rest by score."""
         fixed = self._fixed()
-        if fixed is not None:  # the count the user fixed: the other rows (the ARX stage's) only ranked the orders
-            table = [r for r in table if (r["params"].get("n_regions") or 1) == fixed]
+        table = self._at_fixed_count(table)  # with a count fixed, the ARX stage's rows only ranked the orders
         ok = [r for r in table if np.isfinite(self._score(r))]
         if not ok:
             reasons = sorted({r["error"] or "free run diverged" for r in table})[:3]
