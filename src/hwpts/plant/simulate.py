@@ -193,16 +193,18 @@ def _integrate(t, h_cmd, wp_cmd, p, z0, rtol, atol, max_step, out, stats, hstate
 
 
 def _held_grid(t: np.ndarray, long_hold: float):
-    """``(grid, source)``: the instants ``t`` with every hold longer than ``long_hold`` cut into
-    equal pieces of at most that length, and for each grid instant the sample whose inputs hold there."""
+    """``(grid, source, rows)``: the instants ``t`` with every hold longer than ``long_hold`` cut
+    into equal pieces of at most that length, for each grid instant the sample whose inputs hold
+    there, and the grid index of each instant of ``t``."""
     steps = np.diff(t)
     pieces = np.maximum(1, np.ceil(steps / long_hold).astype(np.int64)) if t.size > 1 else np.zeros(0, np.int64)
+    rows = np.concatenate([[0], np.cumsum(pieces)])
     if not np.any(pieces > 1):
-        return t, np.arange(t.size)
+        return t, np.arange(t.size), rows
     source = np.repeat(np.arange(t.size - 1), pieces)
-    within = np.arange(source.size) - np.repeat(np.cumsum(pieces) - pieces, pieces)
+    within = np.arange(source.size) - np.repeat(rows[:-1], pieces)
     grid = np.concatenate([t[source] + steps[source] * within / pieces[source], t[-1:]])
-    return grid, np.concatenate([source, [t.size - 1]])
+    return grid, np.concatenate([source, [t.size - 1]]), rows
 
 
 @dataclass(frozen=True)
@@ -331,7 +333,7 @@ def simulate_plant(
         if x0.shape != (N_STATES,) or not np.all(np.isfinite(x0)):
             raise DataError(f"initial_state must be 5 finite numbers, got {initial_state!r}")
     z0 = np.concatenate([x0, h_cmd[:1]])
-    grid, source = _held_grid(t, LONG_HOLD)
+    grid, source, rows = _held_grid(t, LONG_HOLD)
     h_grid, wp_grid = np.ascontiguousarray(h_cmd[source]), np.ascontiguousarray(wp_cmd[source])
     out_grid = np.empty((grid.size, _NZ))
     out_grid[0] = z0
@@ -355,7 +357,7 @@ def simulate_plant(
                     "check the parameters and inputs, or lower rtol"
                 )
             bar.update(round(float(grid[b] - grid[a]), 2))
-    out = out_grid[np.searchsorted(grid, t)] if grid.size != t.size else out_grid
+    out = out_grid[rows]
     state = out[:, :N_STATES]
     wp_actual = pump_speed_actual.py_func(state[:, 0], wp_cmd, p)
     return PlantResponse(
