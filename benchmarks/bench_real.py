@@ -7,7 +7,10 @@ Scoring as each data set's README says: free-run simulation of the test record f
 measured samples; Silverbox and EMPS as RMSE (mV, mm), pick_and_place and the hydraulic actuator as
 fit %.
 
-``python -m benchmarks real [--sets=silverbox,emps,...] [--no-peers] [--pyparc-fits=N] [--repeats=N]``
+``python -m benchmarks real [--sets=silverbox,emps,...] [--regions=S] [--no-peers] [--pyparc-fits=N] [--repeats=N]``
+
+``--regions=S``: the search told the number of regions (``PWARXSearch(..., n_regions=S)``, what
+``hwpts identify --regions S`` runs), the orders and the method still chosen.
 
 The speed comparison on Silverbox: the default search timed ``--repeats`` times (3; it must choose
 the same model every time; the segmenters' caches emptied before each run, as in a new process)
@@ -117,7 +120,7 @@ def main(argv=None) -> int:
         print(f"real-data benchmark skipped: {DATA} not found (set HWPTS_DATA_DIR)")
         return 0
     sets = list(SETS)
-    n_fits, repeats = 5, 3
+    n_fits, repeats, n_regions = 5, 3, "auto"
     for a in argv:
         if a.startswith("--sets="):
             sets = a.split("=", 1)[1].split(",")
@@ -125,6 +128,8 @@ def main(argv=None) -> int:
             n_fits = max(2, int(a.split("=", 1)[1]))
         elif a.startswith("--repeats="):
             repeats = max(1, int(a.split("=", 1)[1]))
+        elif a.startswith("--regions="):
+            n_regions = int(a.split("=", 1)[1])
     pyparc_py = None
     if "--no-peers" not in argv:
         from benchmarks.bench_identification import _pyparc_python
@@ -146,7 +151,7 @@ def main(argv=None) -> int:
             for _ in range(repeats if name == "silverbox" and pyparc_py is not None else 1):
                 clear_caches()  # every run as a user's first: nothing reused from the run before
                 t0 = time.perf_counter()
-                search = PWARXSearch(PWARX(random_state=0), orders="auto").fit(u, y)
+                search = PWARXSearch(PWARX(random_state=0), orders="auto", n_regions=n_regions).fit(u, y)
                 runs.append(time.perf_counter() - t0)
                 if len(runs) > 1 and search.best_params_ != first:
                     raise RuntimeError(f"{name}: the default search chose {first}, then {search.best_params_}")
