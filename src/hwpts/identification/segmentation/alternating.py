@@ -64,39 +64,38 @@ def _fit_thetas(Phi, ys, labels, s, ridge):
 @numba.njit(cache=True, nogil=True)
 def _alternate_kernel(Phi, ys, Z, labels, s, gamma, max_iter, ridge):  # pragma: no cover - compiled
     """The alternation loop of :func:`alternate` compiled (same steps, one pass over the rows per
-    step instead of a dozen array operations): returns (labels, iterations)."""
+    step instead of a dozen array operations): returns (labels, iterations). The regions' normal
+    equations and centroid sums are accumulated over all rows once, then updated with the rows
+    that change region only (late steps move a few rows: on Silverbox's 20,000 training rows the
+    accumulation was half of each step)."""
     n, p = Phi.shape
     d = Z.shape[1]
-    nf = max(d, 1)
     labels = labels.copy()
     theta = np.zeros((s, p))
     cent = np.zeros((s, d))
     cost = np.empty((n, s))
     new = np.empty(n, dtype=np.int64)
+    # running sums per region: the upper triangle of Phi'Phi, Phi'y, the rows' count and Z sums
+    G = np.zeros((s, p, p))
+    r = np.zeros((s, p))
+    counts = np.zeros(s, dtype=np.int64)
+    zsum = np.zeros((s, d))
+    for k in range(n):
+        _move_row(Phi, ys, Z, k, labels[k], 1.0, G, r, zsum)
+        counts[labels[k]] += 1
+    A = np.empty((p, p))
     it = 0
     for it in range(1, max_iter + 1):
         # least squares per region (ridge * max(count, 1) on the diagonal)
-        G = np.zeros((s, p, p))
-        r = np.zeros((s, p))
-        counts = np.zeros(s, dtype=np.int64)
-        cent[:] = 0.0
-        for k in range(n):
-            i = labels[k]
-            counts[i] += 1
-            for a in range(p):
-                r[i, a] += Phi[k, a] * ys[k]
-                for b in range(a, p):
-                    G[i, a, b] += Phi[k, a] * Phi[k, b]
-            for j in range(d):
-                cent[i, j] += Z[k, j]
         for i in range(s):
             for a in range(p):
+                A[a, a] = G[i, a, a] + ridge * max(counts[i], 1)
                 for b in range(a + 1, p):
-                    G[i, b, a] = G[i, a, b]
-                G[i, a, a] += ridge * max(counts[i], 1)
-            theta[i] = np.linalg.solve(G[i], r[i])
+                    A[a, b] = G[i, a, b]
+                    A[b, a] = G[i, a, b]
+            theta[i] = np.linalg.solve(A, r[i])
             for j in range(d):
-                cent[i, j] = cent[i, j] / counts[i] if counts[i] else Z[0, j]
+                cent[i, j] = zsum[i, j] / counts[i] if counts[i] else Z[0, j]
         # residuals, their mean over the assigned rows, and the cost of every row in every region
         sigma2 = 0.0
         for k in range(n):
@@ -113,17 +112,17 @@ def _alternate_kernel(Phi, ys, Z, labels, s, gamma, max_iter, ridge):  # pragma:
                 dist = 0.0
                 for j in range(d):
                     dist += (Z[k, j] - cent[i, j]) ** 2
-                cost[k, i] = cost[k, i] / sigma2 + gamma * dist / nf
+                cost[k, i] = cost[k, i] / sigma2 + gamma * dist / max(d, 1)
                 if cost[k, i] < cost[k, best]:
                     best = i
             new[k] = best
-        counts[:] = 0
+        newcounts = np.zeros(s, dtype=np.int64)
         for k in range(n):
-            counts[new[k]] += 1
+            newcounts[new[k]] += 1
         taken = 0
         worst = np.empty(0, dtype=np.int64)
         for i in range(s):
-            if counts[i] < p:  # re-seed starving regions with the worst-fitted samples
+            if newcounts[i] < p:  # re-seed starving regions with the worst-fitted samples
                 if worst.size == 0:
                     assigned = np.empty(n)
                     for k in range(n):
@@ -136,11 +135,27 @@ def _alternate_kernel(Phi, ys, Z, labels, s, gamma, max_iter, ridge):  # pragma:
         for k in range(n):
             if new[k] != labels[k]:
                 same = False
-                break
+                _move_row(Phi, ys, Z, k, labels[k], -1.0, G, r, zsum)
+                _move_row(Phi, ys, Z, k, new[k], 1.0, G, r, zsum)
+                counts[labels[k]] -= 1
+                counts[new[k]] += 1
+                labels[k] = new[k]
         if same:
             break
-        labels[:] = new
     return labels, it
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _move_row(Phi, ys, Z, k, i, sign, G, r, zsum):  # pragma: no cover - compiled
+    """Add (``sign`` 1) or remove (-1) row ``k`` from region ``i``'s running sums."""
+    p = Phi.shape[1]
+    for a in range(p):
+        v = sign * Phi[k, a]
+        r[i, a] += v * ys[k]
+        for b in range(a, p):
+            G[i, a, b] += v * Phi[k, b]
+    for j in range(Z.shape[1]):
+        zsum[i, j] += sign * Z[k, j]
 
 
 def _objective(Phi, ys, Z, labels, s, gamma, ridge, nf):
