@@ -505,6 +505,8 @@ def test_the_cost_cache_is_bounded_by_bytes_too():
     for k in range(5):
         cache.get_or_compute(k, lambda: (np.zeros(100), 1.0))  # 800 bytes each
     assert list(cache) == [2, 3, 4] and cache._bytes == 2400
+    big = cache.get_or_compute("big", lambda: np.zeros(400))  # larger than the bound alone: not kept
+    assert big.size == 400 and list(cache) == [2, 3, 4] and cache._bytes == 2400
     cache.clear()
     assert cache._bytes == 0 and not cache
 

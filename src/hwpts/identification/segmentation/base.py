@@ -99,7 +99,7 @@ def clear_caches() -> None:
     """Empty the segmenters' caches (:class:`BoundedCache`): what a fresh process starts from, e.g.
     to time a model search as a user's first run (a second search on the same data in the same
     process reuses its threshold costs and clustering features: Silverbox 2.5 -> 1.4 s) or to free
-    their memory (at most 128 MB)."""
+    their memory (at most 128 MB each)."""
     for cache in _CACHES:
         cache.clear()
 
@@ -118,11 +118,13 @@ class BoundedCache(dict):
 
     def get_or_compute(self, key, compute):
         """The value stored under ``key``, or ``compute()`` stored there (the oldest entries dropped
-        when full)."""
+        when full; a value larger than ``maxbytes`` alone is returned, not stored)."""
         hit = self.get(key)
         if hit is None:
             hit = compute()
             size = _nbytes(hit)
+            if self.maxbytes is not None and size > self.maxbytes:
+                return hit
             while self and (len(self) >= self.maxsize
                             or (self.maxbytes is not None and self._bytes + size > self.maxbytes)):
                 self._bytes -= _nbytes(self.pop(next(iter(self))))

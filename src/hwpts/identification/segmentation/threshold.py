@@ -88,7 +88,7 @@ def grid_size(n_grid: int, n_columns: int, p: int) -> int:
 _COST_CACHE = BoundedCache(1024, maxbytes=128 * 2**20)
 # fingerprint of (X, y), constant term -> the scaled rows (_scaled_rows) on which the block costs are
 # computed: a search segments the same training rows for every number of regions
-_ROWS_CACHE = BoundedCache(32, maxbytes=64 * 2**20)
+_ROWS_CACHE = BoundedCache(32, maxbytes=128 * 2**20)
 
 
 def _split_costs(x, Phi, y, min_rows, n_grid, data_key=None):
