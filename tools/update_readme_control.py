@@ -31,8 +31,12 @@ def main(argv=None) -> int:
     head, rest = text.split(START, 1)
     _, tail = rest.split(END, 1)
     cmd = f"$ hwpts control run --scenario {scenario} --seed {summary['seed']} --out {results.name}"
-    block = (f"{START}\n```\n{cmd}\n{metric_table(summary)}\nbest model-based controller: {summary['best']}"
-             f" (RMS error {summary.get('rms_reduction_vs_pi_percent', float('nan')):.0f} % below pi)\n```\n{END}")
+    # the command's own last line, from the files the run wrote
+    n_figures = len(list((results / "figures").glob("*.png")))
+    n_data = len(list((results / "data").glob("*.csv")))
+    last = (f"best model-based controller: {summary['best']}; wrote {results.name}/: summary.json, report.html, "
+            f"{n_figures} figures, {n_data} data files in {summary['timings_s']['total']:.1f} s")
+    block = f"{START}\n```\n{cmd}\n{metric_table(summary)}\n{last}\n```\n{END}"
     readme.write_text(head + block + tail)
     print(f"README.md: control metric table and figure from {results}/ ({scenario}, seed {summary['seed']})")
     return 0
