@@ -172,9 +172,10 @@ def _local_cluster(LocalCluster, n_workers: int | None):
     cluster's own log is silenced below critical (at errors, a worker whose heartbeat raced the
     scheduler's close after a Ctrl-C printed its traceback, seen in one CI run; a task's
     failure or a lost worker still reaches hwpts as the exception of its result). A Ctrl-C or
-    SIGTERM in the second or two the cluster takes to start is held until it has started (stopped half-way, the cluster left its workers'
-    semaphores to multiprocessing's resource tracker, which reported them as leaked after hwpts's
-    last line); the cluster is then closed and the signal delivered to the handler it had."""
+    SIGTERM in the second or two the cluster takes to start is held until it has started
+    (stopped half-way, the cluster left its workers' semaphores to multiprocessing's resource
+    tracker, which reported them as leaked after hwpts's last line); the cluster is then closed
+    and the signal delivered to the handler it had."""
     import gc
     import logging
     import signal
