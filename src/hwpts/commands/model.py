@@ -568,8 +568,8 @@ def cmd_identify(args) -> int:
             raise ParameterError(f"--regions expects an int >= 1 or 'auto', got {regions!r}") from None
         if n_regions < 1:
             raise ParameterError(f"--regions expects an int >= 1, got {n_regions}")
-    share = getattr(SEGMENTATION_METHODS[segmentation](), "min_share", None) if segmentation in (
-        "threshold", "threshold-alternating") else None
+    share = getattr(SEGMENTATION_METHODS[segmentation](), "min_share", None) if segmentation in SEGMENTATION_METHODS \
+        else None  # a method whose split leaves each region a share of the rows (threshold's)
     if share is not None and isinstance(n_regions, int) and n_regions > int(np.ceil(1 / share)) - 1:
         # the split's own limit (each region at least min_share of the rows), said as --regions
         raise ParameterError(f"--regions {n_regions}: expected at most {int(np.ceil(1 / share)) - 1} for "

@@ -73,6 +73,7 @@ def _alternate_kernel(Phi, ys, Z, labels, s, gamma, max_iter, ridge):  # pragma:
     accumulation was half of each step)."""
     n, p = Phi.shape
     d = Z.shape[1]
+    nf = max(d, 1)
     labels = labels.copy()
     theta = np.zeros((s, p))
     cent = np.zeros((s, d))
@@ -115,7 +116,7 @@ def _alternate_kernel(Phi, ys, Z, labels, s, gamma, max_iter, ridge):  # pragma:
                 dist = 0.0
                 for j in range(d):
                     dist += (Z[k, j] - cent[i, j]) ** 2
-                cost[k, i] = cost[k, i] / sigma2 + gamma * dist / max(d, 1)
+                cost[k, i] = cost[k, i] / sigma2 + gamma * dist / nf
                 if cost[k, i] < cost[k, best]:
                     best = i
             new[k] = best
@@ -234,14 +235,7 @@ ANNEAL_ITER = 15  # alternation steps of each continuation stage (it only has to
 AUTO_MIN_RESTARTS = 3
 AUTO_MAX_RESTARTS = 12
 SAME_OBJECTIVE = 1e-6  # relative difference under which two starts reached the same minimum
-# large data: how much lower (relative) the best random-parameter start's objective must be than the
-# clustering and k-means starts' best to be taken instead (_restarts). On the identification run of
-# `hwpts reproduce` (24,000 samples, 5 regions) a random start ended 6.1 % below the clustering
-# start's objective, in modes a linear partition does not reproduce: validated at 88.3 / 78.1 / 72.0 %
-# on cases 2-4 against 94.8 / 94.7 / 91.6 % from the clustering start. Where the random starts are
-# needed, every k-means start ends in a poor basin far above them (the zoo's pwarx_random: 0.028-0.035
-# against the true modes' 0.008, a quarter of it)
-RANDOM_START_GAIN = 0.1
+RANDOM_START_GAIN = 0.1  # large data: how much lower a random start's objective must be (preferred_end)
 
 
 def restarts_needed(objectives, confidence: float = 0.99) -> int:
@@ -260,9 +254,12 @@ def preferred_end(structured, random):
     """The end ``(labels, objective, iterations, restart)`` kept of the clustering and k-means
     starts' best (``structured``) and the random-parameter starts' best (``random``, or None): the
     random one only when its objective is lower by more than :data:`RANDOM_START_GAIN` (relative).
-    Those starts escape a basin that every k-means start finds, far above the true modes; their
-    modes need not be compact, and a slightly lower objective from modes that interleave in the
-    regressor space is a model no linear partition reproduces."""
+    Those starts escape a basin that every k-means start finds, far above the true modes (the zoo's
+    ``pwarx_random``: 0.028-0.035 against the true modes' 0.008); their modes need not be compact,
+    and a slightly lower objective from modes that interleave in the regressor space is a model no
+    linear partition reproduces (the identification run of ``hwpts reproduce``, 24,000 samples, 5
+    regions: a random start 6.1 % below the clustering start's objective validated at 88.3 / 78.1 /
+    72.0 % on cases 2-4, the clustering start's minimum at 94.8 / 94.7 / 91.6 %)."""
     if random is not None and random[1] < (1.0 - RANDOM_START_GAIN) * structured[1]:
         return random
     return structured
