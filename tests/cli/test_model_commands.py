@@ -232,6 +232,38 @@ def test_identify_chooses_the_orders_and_says_why(tmp_path, capsys):
     assert choice["orders"] is None  # one method and count: the grid of orders ranks itself
 
 
+def test_the_librarys_default_search_is_the_commands_default(tmp_path, capsys):
+    """``PWARXSearch(PWARX())`` and ``hwpts identify`` without settings choose the same model: the
+    orders a PWARX leaves None are the ones the search chooses, as those --na/--nb/--nk leave out."""
+    from hwpts.identification import PWARX, PWARXSearch
+
+    rng = np.random.default_rng(3)
+    u = rng.uniform(-1, 1, 600)
+    y = np.zeros(600)
+    for k in range(2, 600):
+        a = 0.8 if y[k - 1] > 0 else 0.3  # two modes switching on y(k-1)
+        y[k] = a * y[k - 1] - 0.2 * y[k - 2] + u[k - 1] + 0.5 * u[k - 2] + 0.02 * rng.standard_normal()
+    path = tmp_path / "pwa.csv"
+    write_csv(path, {"u": u, "y": y})
+    out = tmp_path / "m.json"
+    assert main(["identify", str(path), "--input", "u", "--output", "y", "--out", str(out)]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert PWARX().get_params()["output_order"] is None
+    search = PWARXSearch(PWARX(random_state=0)).fit(u[:, None], y)
+    best = search.best_estimator_
+    st = best.structure_
+    assert (summary["choice"]["na"], summary["choice"]["nb"], summary["choice"]["nk"]) == (st.na, list(st.nb),
+                                                                                           list(st.nk))
+    assert summary["segmentation"] == best.segmentation and summary["n_regions"] == best.n_regions_
+    assert len(summary["candidates"]) == len(search.cv_results_)
+    assert summary["train_fit_percent"] == pytest.approx(best.score(u[:, None], y), abs=1e-3)
+    # orders given to the estimator are kept, the input delay then 1 (as --na 2 --nb 2)
+    given = PWARXSearch(PWARX(output_order=2, input_order=2, random_state=0), try_polish=False,
+                        max_regions=2).fit(u[:, None], y)
+    assert {(r["params"].get("output_order"), r["params"].get("input_delay")) for r in given.cv_results_} == {(None, None)}
+    assert given.best_estimator_.structure_.nk == (1,)
+
+
 def test_identify_says_how_it_ranked_the_orders(tmp_path, capsys):
     """Three modes behind oblique boundaries: no ARX model explains them, a nearest-neighbour
     predictor does, and the orders it predicts best with (the true 1/1/1) are chosen; the summary

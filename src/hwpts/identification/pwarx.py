@@ -63,12 +63,16 @@ class PWARX(BaseEstimator):
 
     Parameters
     ----------
-    output_order : int
+    output_order : int or None
         ``na``, number of past outputs in the regressor (eq. 7).
-    input_order : int or list of int
+    input_order : int, list of int or None
         ``nb`` per input (samples of each input in the regressor).
-    input_delay : int or list of int
+    input_delay : int, list of int or None
         ``nk`` per input; ``0`` uses ``u(k)`` as the paper's eq. 18.
+
+        An order left ``None`` (the default) is not given: the model fitted on its own takes 1,
+        and :class:`~hwpts.identification.PWARXSearch` chooses it on the data, as ``hwpts
+        identify`` does without ``--na``/``--nb``/``--nk`` (:meth:`given_orders`).
     n_regions : int
         Number of regions ``s`` (ignored by ``average``, ``zscore``, ``hyperplane``). A PWARX is
         one model: to choose the number of regions, the method or the orders from the data, wrap
@@ -172,7 +176,7 @@ class PWARX(BaseEstimator):
     100.0
     """
 
-    def __init__(self, output_order=1, input_order=1, input_delay=1, n_regions=2,
+    def __init__(self, output_order=None, input_order=None, input_delay=None, n_regions=2,
                  segmentation="clustering", hyperplanes=None, region_models=None, constant=True,
                  ridge=0.0, refinement_rounds=3, classifier_C=1e4, segmentation_params=None,
                  polish=False, partition_columns=None, sparse_partition=True, max_rows=None,
@@ -222,6 +226,10 @@ class PWARX(BaseEstimator):
                 output_name = y_columns[0]
         u, yy = validate_signals(_as_array(X), _output_vector(y))
         return u, yy, names, output_name
+
+    def given_orders(self) -> tuple:
+        """``(na, nb, nk)`` this model is fitted with: its orders, 1 for each left ``None``."""
+        return tuple(1 if v is None else v for v in (self.output_order, self.input_order, self.input_delay))
 
     def _check_settings(self):
         """One line naming the setting, what it takes and what it got, before any fit (the orders,
@@ -308,9 +316,8 @@ class PWARX(BaseEstimator):
             oname = "y" if "y" not in names else "y_out"
         _check_names(names, oname, n_inputs)
         breaks = _check_breaks(breaks, yy.shape[0])
-        structure = RegressorStructure.create(self.output_order, self.input_order, self.input_delay,
-                                              n_inputs, self.constant, names, oname, self.output_powers,
-                                              *power_scaling(yy))
+        structure = RegressorStructure.create(*self.given_orders(), n_inputs, self.constant, names, oname,
+                                              self.output_powers, *power_scaling(yy))
         structure.check_length(yy.shape[0])
         for j, name in enumerate(names):
             if structure.nb[j] > 0 and np.ptp(u[:, j]) == 0:

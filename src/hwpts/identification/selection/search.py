@@ -17,8 +17,8 @@ Two ways to say what to try:
 - ``param_grid=None`` (the default, what ``hwpts identify`` runs): an adaptive search that a user
   would otherwise do by hand:
 
-  1. **orders** (only those left as ``"auto"``: ``PWARXSearch(..., orders="auto")`` or a dict of
-     candidate lists): each (na, nb, nk) is scored as a single ARX model; the ``n_orders`` best go on,
+  1. **orders** (those the estimator leaves ``None``, as ``PWARX()`` does, or all with
+     ``orders="auto"``, or a dict of candidate lists): each (na, nb, nk) is scored as a single ARX model; the ``n_orders`` best go on,
      the second of them the order with the fewest parameters that the best does not beat by the
      choice's rule (step 5), when it is not among them already (where the held-out fits of the
      orders tie, their ranking is noise: an integrator behind saturations carried 4/2/1, 4/1/1
@@ -303,11 +303,14 @@ class PWARXSearch(BaseEstimator):
     methods : sequence of str
         Segmentation methods of the adaptive search.
     orders : None, "auto" or dict
-        ``None``: the estimator's orders; ``"auto"``: searched over :data:`ORDER_GRID`, its delays
+        ``None`` (default): the estimator's orders, and those it leaves ``None`` (``PWARX()``'s
+        defaults) searched as ``"auto"`` searches them, except that the input delay is 1 when
+        both other orders are given (what ``hwpts identify`` does with the orders its
+        ``--na/--nb/--nk`` leave out); ``"auto"``: all searched over :data:`ORDER_GRID`, its delays
         (0 and 1) replaced by the estimated delay and one less where an input's delay is estimated
         above 1 (:func:`~hwpts.identification.selection.orders.estimate_delays`, as MATLAB's
         ``delayest``); a dict ``{"output_order": [...], "input_order": [...], "input_delay": [...]}``
-        (missing keys keep the estimator's value; ``"input_delay": "auto"`` estimates the delays
+        (missing keys keep the estimator's value, 1 where it is ``None``; ``"input_delay": "auto"`` estimates the delays
         as ``"auto"`` does; a candidate may be a list, one value per input).
     n_orders : int
         Orders carried from the ARX stage to the region stage.
@@ -433,10 +436,22 @@ class PWARXSearch(BaseEstimator):
 
         return clone(self.estimator) if self.estimator is not None else PWARX()
 
+    @staticmethod
+    def open_orders(base) -> dict:
+        """The order grid ``orders=None`` searches: the orders ``base`` leaves ``None``, the input
+        delay ``"auto"`` (estimated) unless both other orders are given (then 1, as ``hwpts
+        identify --na N --nb M``)."""
+        grid = {k: ORDER_GRID[k] for k in ("output_order", "input_order") if getattr(base, k) is None}
+        if base.input_delay is None and grid:
+            grid["input_delay"] = "auto"
+        return grid
+
     def _order_grid(self, base, u, y) -> list[dict]:
         if self.orders is None:
-            return [{}]
-        if self.orders == "auto":
+            grid = self.open_orders(base)
+            if not grid:
+                return [{}]
+        elif self.orders == "auto":
             grid = {**ORDER_GRID, "input_delay": "auto"}
         elif isinstance(self.orders, dict):
             unknown = set(self.orders) - set(ORDER_KEYS)
@@ -632,8 +647,8 @@ class PWARXSearch(BaseEstimator):
     @staticmethod
     def _orders_of(base, orders) -> tuple:
         """``(na, nb, nk)`` of a candidate: its own orders, else the estimator's."""
-        return (orders.get("output_order", base.output_order), orders.get("input_order", base.input_order),
-                orders.get("input_delay", base.input_delay))
+        na, nb, nk = base.given_orders()
+        return orders.get("output_order", na), orders.get("input_order", nb), orders.get("input_delay", nk)
 
     @classmethod
     def _max_lag(cls, base, orders) -> int:
@@ -1156,7 +1171,7 @@ class PWARXSearch(BaseEstimator):
             params = dict(row["params"])
             polish = self.try_polish
             if polish == "auto":
-                polish = params.get("output_order", base.output_order) > 0
+                polish = self._orders_of(base, params)[0] > 0
             if polish and not clone(base).set_params(**params).polish:
                 trial = _evaluate(base, {**params, "polish": True}, u, y, splits, -np.inf, *self._names)
                 trial["stage"] = "polish"
