@@ -56,3 +56,21 @@ def test_column_index_by_input_name():
     assert st.column_index("a(k-2)") == 3
     with pytest.raises(ParameterError, match="unknown regressor column 'c'"):
         st.column_index("c")
+
+
+def test_a_name_that_means_two_columns_is_refused_not_guessed():
+    """An input named ``y(k-1)`` beside the output ``y``: the name is both the output's lag and the
+    input; a hyperplane or partition column by that name is refused, one given by position is the input's."""
+    from hwpts.identification.partition import Hyperplane
+
+    st = RegressorStructure.create(1, 1, 1, 1, input_names=["y(k-1)"], output_name="y")
+    assert st.feature_names == ["y(k-1)", "y(k-1)(k-1)"]
+    with pytest.raises(ParameterError, match="'y\\(k-1\\)' is ambiguous: it names the regressor column"):
+        st.column_index("y(k-1)")
+    assert st.column_index("y(k-1)(k-1)") == 1 and st.column_index("y") == 0
+    a, _ = Hyperplane([1.0], 0.0).resolve(st)  # on the first input, by position
+    np.testing.assert_array_equal(a, [0.0, 1.0])
+    # an output named as an input's lag
+    st = RegressorStructure.create(1, 1, 1, 1, input_names=["u"], output_name="u(k-1)")
+    with pytest.raises(ParameterError, match="ambiguous"):
+        st.column_index("u(k-1)")

@@ -41,10 +41,13 @@ def test_parquet_round_trip(tmp_path):
 
 def test_mat_vectors_and_matrices(tmp_path):
     path = tmp_path / "d.mat"
-    savemat(path, {"u": np.arange(5.0).reshape(-1, 1), "m": np.ones((5, 2)), "s": "text"})
+    savemat(path, {"u": np.arange(5.0).reshape(-1, 1), "m": np.ones((5, 2)), "s": "text",
+                   "w": np.arange(10.0).reshape(2, 5), "q": np.eye(3)})
     cols = read_table(path)
-    assert set(cols) == {"u", "m_1", "m_2"}
+    # a matrix's longer side is its samples; a square one could be either way round and is not read
+    assert set(cols) == {"u", "m_1", "m_2", "w_1", "w_2"}
     np.testing.assert_array_equal(cols["u"], np.arange(5.0))
+    np.testing.assert_array_equal(cols["w_2"], np.arange(5.0, 10.0))
 
 
 @pytest.mark.parametrize("text, match", [

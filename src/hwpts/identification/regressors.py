@@ -236,22 +236,36 @@ class RegressorStructure:
         """Index in x_k of a regressor column, by regressor name (``u1(k-1)``) or input name.
 
         An input name refers to that input's most recent sample in the regressor (``u(k-nk)``);
-        the output name refers to ``y(k-1)``.
+        the output name refers to ``y(k-1)``. A name that means two columns (an input named
+        ``y(k-1)`` beside the output ``y``) is refused rather than guessed.
         """
         names = self.feature_names
+        meanings = {}
         if name in names:
-            return names.index(name)
+            meanings[names.index(name)] = f"the regressor column {name!r}"
         if name in self.input_names:
             j = self.input_names.index(name)
-            if self.nb[j] == 0:
+            if self.nb[j] > 0:
+                meanings.setdefault(self.input_column(j), f"the input {name!r}")
+            elif not meanings:
                 raise ParameterError(f"input {name!r} has nb=0: it is not in the regressor")
-            return self.na + sum(self.nb[:j])
         if name == self.output_name and self.na > 0:
-            return 0
+            meanings.setdefault(0, f"the output {name!r}")
+        if len(meanings) > 1:
+            raise ParameterError(f"column name {name!r} is ambiguous: it names {' and '.join(meanings.values())}, "
+                                 f"different regressor columns; rename the data's column")
+        if meanings:
+            return next(iter(meanings))
         raise ParameterError(
             f"unknown regressor column {name!r}; valid names are {names} or the inputs "
             f"{list(self.input_names)}"
         )
+
+    def input_column(self, j: int) -> int:
+        """Index in x_k of input ``j``'s most recent sample (``u_j(k-nk_j)``)."""
+        if self.nb[j] == 0:
+            raise ParameterError(f"input {self.input_names[j]!r} has nb=0: it is not in the regressor")
+        return self.na + sum(self.nb[:j])
 
     def build(self, inputs: np.ndarray, output: np.ndarray, fit: bool = True) -> tuple[np.ndarray, np.ndarray]:
         """Regressor matrix X (rows x_k', eq. 7) and targets y(k), for k = max_lag .. n-1.

@@ -430,8 +430,9 @@ def _loadmat_isolated(p: Path) -> dict:
 def _read_mat(p: Path) -> dict[str, np.ndarray]:
     """Each variable of a MATLAB file becomes a column (vectors) or several (``name_1``... for matrices).
 
-    The file is parsed in a child process (:func:`_loadmat_isolated`); text, cells and structs are
-    skipped; complex and sparse variables are refused.
+    The file is parsed in a child process (:func:`_loadmat_isolated`); text, cells, structs and
+    square matrices (whose samples could run down or across) are skipped; complex and sparse
+    variables are refused. A matrix's longer side is its samples.
     """
     raw = _loadmat_isolated(p)
     out = {}
@@ -452,7 +453,9 @@ def _read_mat(p: Path) -> dict[str, np.ndarray]:
         if arr.ndim == 2 and 1 in arr.shape:
             out[name] = arr.reshape(-1)
         elif arr.ndim == 2:
-            if arr.shape[0] < arr.shape[1]:
+            if arr.shape[0] == arr.shape[1]:  # samples down or across: nothing tells which, so not read
+                continue
+            if arr.shape[0] < arr.shape[1]:  # the longer side is the samples
                 arr = arr.T
             for j in range(arr.shape[1]):
                 column = f"{name}_{j + 1}"

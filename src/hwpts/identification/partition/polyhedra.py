@@ -291,12 +291,12 @@ class Hyperplane:
                     f"hyperplane {self} has {len(self.coefficients)} coefficients but the model has "
                     f"{structure.n_inputs} input(s); name the columns with '@col1,col2'"
                 )
-            columns = structure.input_names[: len(self.coefficients)]
+            index = [structure.input_column(j) for j in range(len(self.coefficients))]  # by position
         else:
-            columns = self.columns
+            index = [structure.column_index(col) for col in self.columns]
         a = np.zeros(structure.n_features)
-        for coef, col in zip(self.coefficients, columns):
-            a[structure.column_index(col)] += coef
+        for coef, i in zip(self.coefficients, index):
+            a[i] += coef
         return a, self.offset
 
     def to_dict(self) -> dict:
