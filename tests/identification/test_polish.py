@@ -82,3 +82,41 @@ def test_gram_path_only_where_the_gauss_newton_matrix_keeps_its_digits():
     rc, jc = compress(r, near)
     np.testing.assert_allclose(jc.T @ rc, near.T @ r, rtol=1e-8, atol=1e-8 * np.abs(near.T @ r).max())
     np.testing.assert_allclose(rc @ rc, r @ r, rtol=1e-10)
+
+
+@pytest.mark.parametrize("segmentation, kw", [("threshold", {}), ("alternating", {}),
+                                              ("threshold", {"output_powers": (2, 3)})])
+def test_the_polish_does_not_depend_on_where_the_signals_zeros_are(segmentation, kw):
+    """The same data with the output 1000 higher and the input 50 higher (absolute or gauge
+    pressure): the same polished model, its offset moved and nothing else. On raw signals the
+    solvers' first trust region grew with the offsets and the polish landed elsewhere."""
+    from hwpts.identification import PWARX
+
+    rng = np.random.default_rng(0)
+    u = rng.uniform(-1, 1, (600, 1))
+    y = np.zeros(600)
+    for k in range(2, 600):
+        y[k] = (0.9 if y[k - 1] > 0 else 0.5) * y[k - 1] - 0.1 * y[k - 2] + u[k - 1, 0] + 0.05 * rng.standard_normal()
+    models = [PWARX(2, 1, 1, segmentation=segmentation, n_regions=2, polish=True, random_state=0, **kw)
+              .fit(u + du, y + dy) for du, dy in ((0.0, 0.0), (50.0, 1000.0))]
+    assert models[0].segmentation_info_["polish"]["accepted"]
+    np.testing.assert_allclose(models[1].theta_[:, :-1], models[0].theta_[:, :-1], rtol=1e-5, atol=1e-7)
+    assert models[1].score(u + 50.0, y + 1000.0) == pytest.approx(models[0].score(u, y), abs=1e-4)
+
+
+def test_a_shifted_partition_holds_the_same_rows():
+    """RegionPartition.shifted(m): row x - m of the copy is in the region of row x, whichever way
+    the partition assigns rows (classifier scores, threshold cuts, polyhedra)."""
+    from hwpts.identification.partition.polyhedra import RegionPartition, fit_linear_partition
+
+    rng = np.random.default_rng(1)
+    X = rng.standard_normal((300, 3))
+    labels = (X[:, 0] + 0.5 * X[:, 1] > 0).astype(int) + (X[:, 2] > 1).astype(int)
+    m = np.array([10.0, -3.0, 100.0])
+    learned = fit_linear_partition(X, labels, 3)
+    cut = RegionPartition([np.array([[1.0, 0, 0]]), np.array([[-1.0, 0, 0]])], [np.array([-0.2]), np.array([0.2])])
+    cut.cuts = (0, np.array([0.2]))
+    for partition in (learned, cut):
+        shifted = partition.shifted(m)
+        np.testing.assert_array_equal(shifted.predict(X - m), partition.predict(X))
+        np.testing.assert_array_equal(shifted.violations(X - m).argmin(axis=1), partition.violations(X).argmin(axis=1))

@@ -147,9 +147,12 @@ def test_local_covariance_is_sigma2_times_the_inverse_normal_matrix(n, n_feature
 @given(n=st.integers(12, 400), n_features=st.integers(1, 6), n_regions=st.integers(1, 3), constant=st.booleans(),
        ridge=st.sampled_from([0.0, 1e-4, 1e-1]), seed=st.integers(0, 2**16))
 def test_local_least_squares_is_the_scaled_ridge_solution(n, n_features, n_regions, constant, ridge, seed):
-    """Each region's parameters (eq. 17) are the least squares of ``[X 1]`` with each column over
-    its root mean square and ``ridge * n`` on the scaled regressors' diagonal, whichever path solved
-    them (normal equations or the SVD): what any faster formulation must keep."""
+    """Each region's parameters (eq. 17) are the least squares of ``X`` centred (with a constant
+    term; the intercept then from the means) with each column over its root mean square and
+    ``ridge * n`` on the scaled regressors' diagonal, whichever path solved them (normal equations
+    or the SVD): what any faster formulation must keep. Without a ridge that is the plain least
+    squares of ``[X 1]``; with one, the slopes do not depend on the regressors' or the output's
+    offsets."""
     from hwpts.identification.local_models import fit_local_models
 
     rng = np.random.default_rng(seed)
@@ -159,14 +162,18 @@ def test_local_least_squares_is_the_scaled_ridge_solution(n, n_features, n_regio
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         models = fit_local_models(X, y, labels, n_regions, constant, ridge=ridge)
+        shifted = fit_local_models(X + 1e3, y - 1e3, labels, n_regions, constant, ridge=ridge)
     for i in range(n_regions):
         Xi, yi = X[labels == i], y[labels == i]
-        Phi = np.hstack([Xi, np.ones((len(yi), 1))]) if constant else Xi
-        scale = np.sqrt(np.mean(Phi**2, axis=0))
-        A, b = Phi / scale, yi
+        xm, ym = (Xi.mean(axis=0), yi.mean()) if constant else (0.0, 0.0)
+        scale = np.sqrt(np.mean((Xi - xm) ** 2, axis=0))
+        A, b = (Xi - xm) / scale, yi - ym
         if ridge > 0:
-            A = np.vstack([A, np.sqrt(ridge * len(yi)) * np.eye(n_features, A.shape[1])])
-            b = np.concatenate([yi, np.zeros(n_features)])
-        expected = np.linalg.lstsq(A, b, rcond=None)[0] / scale
-        got = models.theta[i] if constant else models.theta[i, :-1]
-        np.testing.assert_allclose(got * scale, expected * scale, rtol=1e-6, atol=1e-8)
+            A = np.vstack([A, np.sqrt(ridge * len(yi)) * np.eye(n_features)])
+            b = np.concatenate([b, np.zeros(n_features)])
+        slopes = np.linalg.lstsq(A, b, rcond=None)[0] / scale
+        got = models.theta[i]
+        np.testing.assert_allclose(got[:-1] * scale, slopes * scale, rtol=1e-6, atol=1e-8)
+        np.testing.assert_allclose(got[-1], ym - xm @ slopes if constant else 0.0, rtol=1e-6, atol=1e-8)
+        if constant:  # offsets move the intercept alone
+            np.testing.assert_allclose(shifted.theta[i, :-1] * scale, got[:-1] * scale, rtol=1e-6, atol=1e-7)

@@ -448,7 +448,7 @@ def test_search_and_polish_run_blas_single_threaded(monkeypatch):
     assert all(n == 1 for _, n in seen)
     seen.clear()
     PWARX(1, 1, 1, n_regions=2, segmentation="threshold", polish=True).fit(u, y)  # the polish alone too
-    assert seen == [("polish", 1)] * 2  # a short record: trust region and Levenberg-Marquardt
+    assert seen == [("polish", 1)]  # one trust-region descent
     assert polish_free_run is polish_module.polish_free_run
 
 
@@ -512,9 +512,10 @@ def test_free_run_sensitivity_is_the_derivative_of_the_free_run(seed):
         assert np.allclose(J[same, j], numeric[same], rtol=1e-4, atol=1e-6 * max(1.0, np.abs(numeric).max()))
 
 
-def test_polish_keeps_the_better_of_two_descents_on_short_records(monkeypatch):
-    """On a short record the polish runs trf and lm from the same start and keeps the lower
-    training cost: never worse than trf alone; long records run trf only."""
+def test_polish_is_one_trust_region_descent_that_never_raises_the_training_error(monkeypatch):
+    """One descent (trust region reflective, on the centred signals), kept only where it lowers
+    the training free-run error: a second (Levenberg-Marquardt) one's lower costs on short records
+    were minima that did not generalise (hwpts.identification.polish.polish_free_run)."""
     import hwpts.identification.polish as polish_module
 
     from scipy.optimize import least_squares
@@ -526,18 +527,15 @@ def test_polish_keeps_the_better_of_two_descents_on_short_records(monkeypatch):
         return least_squares(*args, **kwargs)
 
     monkeypatch.setattr("scipy.optimize.least_squares", spy)
-    rows = polish_module.SECOND_SOLVER_ROWS
     for seed in range(4):
         d = make_system(5, rng=seed, n=400)
         model = PWARX(2, 2, 1, n_regions=3, segmentation="alternating", random_state=seed).fit(d.inputs, d.output)
         args = (model.structure_, model.partition_, model.theta_, ("affine",) * model.n_regions_, d.inputs,
                 d.output, *model.divergence_band())
         methods.clear()
-        _, both = polish_module.polish_free_run(*args)
-        assert methods == ["trf", "lm"] and both["method"] in ("trf", "lm")
-        monkeypatch.setattr(polish_module, "SECOND_SOLVER_ROWS", 0)
-        methods.clear()
-        _, trf = polish_module.polish_free_run(*args)
-        monkeypatch.setattr(polish_module, "SECOND_SOLVER_ROWS", rows)
+        theta, info = polish_module.polish_free_run(*args)
         assert methods == ["trf"]
-        assert both["final_sse"] <= trf["final_sse"] * (1 + 1e-12)
+        if info["accepted"]:
+            assert info["final_sse"] < info["initial_sse"]
+        else:
+            np.testing.assert_array_equal(theta, model.theta_)

@@ -84,50 +84,52 @@ class LocalModels:
 
 
 def _scaled(X: np.ndarray, constant: bool):
-    """``(A, scale)``: the regressors ``[X 1]`` divided by each column's root mean square (1 for a
-    zero column)."""
+    """``(A, scale, mean)``: the regressors ``X`` centred (with a constant term: the offset is
+    then the intercept's, fitted apart) and divided by each column's root mean square (1 for a
+    zero column). Centred, neither a ridge penalty nor the minimum-norm solution of a
+    rank-deficient region depends on where the signals' zeros are: on raw columns an input offset
+    of 300 shrank a ridge-fitted input gain of 2.0 to 0.007, and a region whose input was constant
+    put -2.16 or -100.8 on that input as the output's zero moved by 1000."""
     n = X.shape[0]
-    Phi = np.hstack([X, np.ones((n, 1))]) if constant else X
-    scale = np.sqrt(np.mean(Phi**2, axis=0)) if n else np.ones(Phi.shape[1])
-    scale[scale == 0] = 1.0
-    return Phi / scale, scale
+    mean = X.mean(axis=0) if constant and n else np.zeros(X.shape[1])
+    A = X - mean if constant and n else X
+    scale = np.sqrt(np.mean(A**2, axis=0)) if n else np.ones(X.shape[1])
+    scale[~(scale > 1e-300)] = 1.0
+    return A / scale, scale, mean
 
 
 def _fit_region(X: np.ndarray, y: np.ndarray, constant: bool, ridge: float = 0.0):
-    """``(theta, cond, G, scale)``: least squares of one region (:func:`solve_region`), with the
-    column-scaled normal matrix ``G = A' A`` that :func:`parameter_covariance` needs (``None``
-    when it was not formed: a ridge, or the SVD path), so that it is not formed twice."""
+    """``(theta, cond, G, scale, mean)``: least squares of one region (:func:`solve_region`) on
+    the centred, column-scaled regressors (:func:`_scaled`), the intercept from the means, with
+    the normal matrix ``G = A' A`` that :func:`parameter_covariance` needs (``None`` when it was
+    not formed: a ridge, or the SVD path), so that it is not formed twice."""
     n, nf = X.shape
-    A, scale = _scaled(X, constant)
-    b = y
-    if ridge > 0:
-        pen = np.sqrt(ridge * max(n, 1)) * np.eye(A.shape[1])
-        if constant:
-            pen = pen[:-1]
-        A = np.vstack([A, pen])
-        b = np.concatenate([y, np.zeros(pen.shape[0])])
+    A, scale, mean = _scaled(X, constant)
+    ym = float(y.mean()) if constant and n else 0.0
+    b = y - ym
+    if ridge > 0:  # on the slopes only: the intercept is the means'
+        A = np.vstack([A, np.sqrt(ridge * max(n, 1)) * np.eye(nf)])
+        b = np.concatenate([b, np.zeros(nf)])
     coef = G = None
     if A.shape[0] >= 4 * A.shape[1]:  # tall: normal equations (fast), if well conditioned
         G = A.T @ A
-        ev = np.linalg.eigvalsh(G)
+        ev = np.linalg.eigvalsh(G) if nf else np.ones(1)
         cond = float(np.sqrt(ev[-1] / ev[0])) if ev[0] > 0 else float("inf")
         if cond < 1e6:
             coef = np.linalg.solve(G, A.T @ b)
-    if coef is None:  # SVD least squares: robust to rank deficiency
+    if coef is None:  # SVD least squares: robust to rank deficiency (minimum norm)
         coef, _, rank, sv = np.linalg.lstsq(A, b, rcond=None)
         cond = float(sv[0] / sv[-1]) if sv.size and sv[-1] > 0 else float("inf")
-    coef = coef / scale
     theta = np.zeros(nf + 1)
+    theta[:nf] = coef / scale
     if constant:
-        theta[:] = coef
-    else:
-        theta[:nf] = coef
-    return theta, cond, (G if ridge == 0 else None), scale
+        theta[nf] = ym - float(mean @ theta[:nf])
+    return theta, cond, (G if ridge == 0 else None), scale, mean
 
 
 def solve_region(X: np.ndarray, y: np.ndarray, constant: bool, ridge: float = 0.0) -> tuple[np.ndarray, float]:
-    """Least squares (eq. 17) of one region on column-scaled regressors; returns (theta, cond)."""
-    theta, cond, _, _ = _fit_region(X, y, constant, ridge)
+    """Least squares (eq. 17) of one region on centred, column-scaled regressors; returns (theta, cond)."""
+    theta, cond, _, _, _ = _fit_region(X, y, constant, ridge)
     return theta, cond
 
 
@@ -138,12 +140,14 @@ def parameter_covariance(X: np.ndarray, y: np.ndarray, theta: np.ndarray, consta
     ``[x' 1]`` (offset last; its row and column are zero without a constant term). ``nan`` when the
     region has no more samples than parameters.
     """
-    A, scale = _scaled(np.asarray(X, dtype=float), constant)
-    return _covariance(X, y, theta, constant, A.T @ A, scale)
+    A, scale, mean = _scaled(np.asarray(X, dtype=float), constant)
+    return _covariance(X, y, theta, constant, A.T @ A, scale, mean)
 
 
-def _covariance(X, y, theta, constant, G, scale) -> np.ndarray:
-    """:func:`parameter_covariance` from the column-scaled normal matrix ``G`` already formed."""
+def _covariance(X, y, theta, constant, G, scale, mean) -> np.ndarray:
+    """:func:`parameter_covariance` from the centred, column-scaled normal matrix ``G`` already
+    formed: the slopes' ``sigma^2 G^-1`` (scaled back), and the intercept ``c - mean' beta`` of the
+    centred fit's ``c`` (variance ``sigma^2 / n``, uncorrelated with the slopes)."""
     n, nf = X.shape
     cov = np.full((nf + 1, nf + 1), np.nan)
     p = nf + int(constant)
@@ -151,12 +155,13 @@ def _covariance(X, y, theta, constant, G, scale) -> np.ndarray:
         return cov
     r = y - X @ theta[:nf] - theta[nf]
     sigma2 = float(r @ r) / (n - p)
-    inv = np.linalg.pinv(G) / np.outer(scale, scale)
+    slopes = sigma2 * np.linalg.pinv(G) / np.outer(scale, scale)
+    cov[:] = 0.0
+    cov[:nf, :nf] = slopes
     if constant:
-        cov[:] = sigma2 * inv
-    else:
-        cov[:] = 0.0
-        cov[:nf, :nf] = sigma2 * inv
+        cross = -slopes @ mean
+        cov[:nf, nf] = cov[nf, :nf] = cross
+        cov[nf, nf] = sigma2 / n + float(mean @ slopes @ mean)
     return cov
 
 
@@ -210,18 +215,18 @@ def fit_local_models(X: np.ndarray, y: np.ndarray, labels: np.ndarray, n_regions
                 f"the minimum-norm least-squares solution", "starved", region=i + 1, rows=int(counts[i]),
                 parameters=n_par), stacklevel=2)
         Xi, yi = (X, y) if counts[i] == labels.size else (X[mask], y[mask])  # one region: no copy
-        theta[i], cond[i], G, scale = _fit_region(Xi, yi, constant, ridge)
+        theta[i], cond[i], G, scale, mean = _fit_region(Xi, yi, constant, ridge)
         if trim is not None and counts[i] > 2 * n_par:
             r = yi - Xi @ theta[i, :-1] - theta[i, -1]
             sd = 1.4826 * np.median(np.abs(r - np.median(r)))
             keep = np.abs(r) <= trim * sd
             if sd > 0 and n_par < keep.sum() < keep.size:
                 Xi, yi = Xi[keep], yi[keep]
-                theta[i], cond[i], G, scale = _fit_region(Xi, yi, constant, ridge)
+                theta[i], cond[i], G, scale, mean = _fit_region(Xi, yi, constant, ridge)
         if G is None:  # a ridge or the SVD path: the plain normal matrix was not formed
-            A, scale = _scaled(Xi, constant)
+            A, scale, mean = _scaled(Xi, constant)
             G = A.T @ A
-        cov[i] = _covariance(Xi, yi, theta[i], constant, G, scale)
+        cov[i] = _covariance(Xi, yi, theta[i], constant, G, scale, mean)
         if warn and counts[i] >= n_par and cond[i] > ILL_CONDITIONED:
             warnings.warn(RegionWarning(
                 f"region {i + 1}: least squares is ill-conditioned (condition number {cond[i]:.3g}); "

@@ -121,6 +121,21 @@ class RegionPartition:
             first[none] = np.argmin(v[none], axis=1)
         return first.astype(np.int64)
 
+    def shifted(self, m: np.ndarray) -> RegionPartition:
+        """The same regions over ``x - m``: a row ``x_s`` lies in region ``i`` of the copy
+        exactly when ``x_s + m`` lies in region ``i`` of this partition (``g + H m``, the
+        classifier's ``b + W m``, the cuts less ``m`` of their column)."""
+        m = np.asarray(m, dtype=float)
+        out = RegionPartition([h.copy() for h in self.H], [gi + h @ m for h, gi in zip(self.H, self.g)],
+                              kind=self.kind)
+        if self.scores is not None:
+            W, b = self.scores
+            out.scores = (np.array(W, dtype=float), np.asarray(b, dtype=float) + np.asarray(W, dtype=float) @ m)
+        if self.cuts is not None:
+            column, t = self.cuts
+            out.cuts = (column, np.asarray(t, dtype=float) - m[column])
+        return out
+
     def flat(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Stacked rows for compiled loops: H_all (R, n), g_all (R,), row_start (s + 1,)."""
         counts = [h.shape[0] for h in self.H]
