@@ -252,12 +252,24 @@ def _report(error: BaseException) -> int:
 
 
 def finish(status: int) -> None:  # pragma: no cover - the console script's exit (hwpts._console)
-    """Exit with ``status``. After an interrupt (130) the process ends at once (``os._exit``,
-    streams flushed): a signal that landed inside a compiled library (LLVM compiling a numba
-    kernel) can leave it in a state whose teardown at interpreter exit crashes; every output and
-    temporary file is already settled."""
-    if status == 130:
-        sys.stdout.flush()
-        sys.stderr.flush()
-        os._exit(130)
-    sys.exit(status)
+    """Exit with ``status`` once the streams are flushed and Python's exit handlers have run,
+    without the native libraries' teardown (``os._exit``): every output and temporary file is
+    settled by then. That teardown crashed now and then on a fast exit, the run's thread pools
+    still starting: after the one line of a bad argument, ``terminate called without an active
+    exception`` and status 134 instead of 2 (2 of 40 runs of one command on a busy machine). After
+    an interrupt (130) the exit handlers are skipped too: a signal that landed inside a compiled
+    library (LLVM compiling a numba kernel) can leave it in a state that crashes them."""
+    import atexit
+
+    if status != 130:
+        try:
+            atexit._run_exitfuncs()
+        except BaseException:  # noqa: BLE001 - an exit handler's failure must not change the status
+            pass
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            if stream is not None:
+                stream.flush()
+        except (OSError, ValueError):  # a closed or full stream: nothing more can be said
+            pass
+    os._exit(status)
