@@ -40,8 +40,23 @@ def test_to_control_rejects_a_bad_sample_time():
     model = PWARX(2, 2, 1, n_regions=1, segmentation="average").fit(d.inputs, d.output)
     with pytest.raises(ParameterError, match="dt must be"):
         model.to_control(dt=-1.0)
+    with pytest.raises(ParameterError, match="dt must be"):
+        model.to_control(dt="a")
     (sys,) = model.to_control()
     assert sys.dt is True and list(sys.input_labels) == ["u1", "u2", "offset"]
+
+
+def test_an_input_named_offset_keeps_its_own_channel():
+    """python-control merges equal labels: an input named ``offset`` beside the constant channel
+    made ``sys[:, "offset"]`` the constant; the constant is then ``offset_1``."""
+    from hwpts.identification.analysis import state_space_export
+    from hwpts.io.export import control_script
+
+    d = make_system(5, rng=0, n=600)
+    model = PWARX(2, 2, 1, n_regions=1, segmentation="average").fit(d.inputs, d.output, input_names=["offset", "p"])
+    (sys,) = model.to_control()
+    assert list(sys.input_labels) == ["offset", "p", "offset_1"] and sys.input_index["offset"] == 0
+    assert "INPUTS = ['offset', 'p', 'offset_1']" in control_script(state_space_export(model), "test", "m")
 
 
 def _two_mode_data(rng, n=400, sigma=0.1):

@@ -35,17 +35,21 @@ def _control():
 
 
 def to_control(model, dt=None) -> list:
-    """One python-control ``StateSpace`` per mode of a fitted ``PWARX`` (offset as the last input).
+    """One python-control ``StateSpace`` per mode of a fitted ``PWARX`` (offset as the last input,
+    named ``offset`` unless an input is: :func:`~hwpts.identification.statespace.offset_input_name`).
 
     ``dt``: the sample time in seconds; ``None`` gives a discrete-time system with an unspecified
     sample time (``dt=True`` in python-control).
     """
     _affine_only(model, "to_control")
     control = _control()
-    if dt is not None and (isinstance(dt, bool) or not np.isfinite(dt) or dt <= 0):
+    if dt is not None and (isinstance(dt, (bool, np.bool_)) or not isinstance(dt, (int, float, np.integer, np.floating))
+                           or not np.isfinite(dt) or dt <= 0):
         raise ParameterError(f"dt must be a positive number of seconds or None, got {dt!r}")
+    from hwpts.identification.statespace import offset_input_name
+
     out = []
-    names = [*model.structure_.input_names, "offset"]
+    names = [*model.structure_.input_names, offset_input_name(model.structure_.input_names)]
     for i, ss in enumerate(model.state_space()):
         B = np.column_stack([ss.B, ss.e]) if ss.A.size else np.zeros((0, len(names)))
         D = np.concatenate([ss.D.ravel(), [ss.c]]).reshape(1, -1)

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["ModeStateSpace", "mode_state_space"]
+__all__ = ["ModeStateSpace", "mode_state_space", "offset_input_name"]
 
 
 @dataclass(frozen=True)
@@ -79,3 +79,15 @@ def mode_state_space(structure, theta: np.ndarray) -> ModeStateSpace:
     poles = np.linalg.eigvals(A) if n_state else np.zeros(0)
     poles = poles[np.argsort(-np.abs(poles))]
     return ModeStateSpace(A, B, C.reshape(1, -1), D.reshape(1, -1), e, float(theta[-1]), poles)
+
+
+def offset_input_name(input_names) -> str:
+    """The name of the constant input (held at 1) that carries a mode's offset in an exported
+    state space: ``offset``, or ``offset_1``, ``offset_2``, ... when an input has that name (a
+    python-control system merges equal labels, and ``sys[:, "offset"]`` took the constant)."""
+    taken = set(input_names)
+    name, k = "offset", 0
+    while name in taken:
+        k += 1
+        name = f"offset_{k}"
+    return name

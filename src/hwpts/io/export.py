@@ -95,7 +95,9 @@ def control_script(doc: dict, generator: str, model_name: str) -> str:
     ``H``, ``g`` are in ``REGIONS``. Numbers are written with ``repr``: exact round trip.
     """
     dt = doc["sample_time_s"]
-    inputs = [*doc["inputs"], "offset"]
+    from hwpts.identification.statespace import offset_input_name
+
+    inputs = [*doc["inputs"], offset_input_name(doc["inputs"])]
     # the names go into the docstring as a Python literal's text: a file name holding quotes or a
     # line break (a crafted '"""' then code) cannot end the docstring or add a line of code
     lines = [
