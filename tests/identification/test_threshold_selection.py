@@ -745,6 +745,25 @@ def test_a_fixed_count_carries_the_orders_that_can_hold_it(monkeypatch):
     assert search.best_params_["n_regions"] == 30
 
 
+def test_a_count_no_order_can_hold_and_an_estimators_own_partition_are_said_not_replaced():
+    """``n_regions=50`` on 400 rows gave a 6-region model after a cascade of dropped regions (the
+    command refuses ``--regions 50`` there); an estimator's own method, count or hyperplanes were
+    silently replaced by the search's choice. Each is one line saying how to keep it."""
+    u, y = setar(400, 0)
+    fast = {"try_polish": False, "shared_modes": False, "output_powers": None}
+    with pytest.raises(ParameterError, match=r"n_regions=50: expected at most 35 for the 320 training rows"):
+        PWARXSearch(PWARX(1, 1, 1, random_state=0), n_regions=50, **fast).fit(u, y)
+    with pytest.raises(ParameterError, match=r"the estimator's n_regions=3 would be replaced .* n_regions=3\) to keep"):
+        PWARXSearch(PWARX(1, 1, 1, segmentation="threshold", n_regions=3), **fast).fit(u, y)
+    with pytest.raises(ParameterError, match=r"segmentation 'kmeans' is not among the methods .* methods=\['kmeans'\]"):
+        PWARXSearch(PWARX(1, 1, 1, segmentation="kmeans"), **fast).fit(u, y)
+    with pytest.raises(ParameterError, match=r"segmentation 'hyperplane' fixes its partition"):
+        PWARXSearch(PWARX(1, 1, 1, segmentation="hyperplane", hyperplanes=["1,0"]), **fast).fit(u, y)
+    kept = PWARXSearch(PWARX(1, 1, 1, segmentation="threshold", n_regions=3, random_state=0), methods=["threshold"],
+                       n_regions=3, **fast).fit(u, y)
+    assert kept.best_params_["segmentation"] == "threshold" and kept.best_estimator_.n_regions_ == 3
+
+
 def test_a_fixed_count_prefers_the_models_that_kept_every_region():
     """Among the candidates the best does not beat, a fixed count puts those whose fits kept all
     of its regions first (a learned segmentation may drop some); the ARX rows only ranked the orders."""

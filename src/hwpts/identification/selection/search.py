@@ -289,7 +289,11 @@ class PWARXSearch(BaseEstimator):
     ----------
     estimator : PWARX, optional
         The model whose parameters are searched (default ``PWARX()``); its other parameters
-        (ridge, partition columns, random_state...) are kept.
+        (ridge, partition columns, random_state...) are kept. Its orders left ``None`` are
+        chosen (``orders``). The adaptive search chooses the method and the number of regions: an
+        estimator with its own (a segmentation outside ``methods``, ``n_regions`` other than
+        PWARX's 2 without the same ``n_regions`` here, hyperplanes or another fixed partition) is
+        refused with a line saying how to keep them, not silently replaced.
     param_grid : dict, list, or None
         Explicit candidates (see :func:`expand_grid`); ``None`` runs the adaptive search (module doc).
     cv : int, splitter or None
@@ -633,6 +637,7 @@ class PWARXSearch(BaseEstimator):
                                              f"have; valid are {sorted(valid)}")
                     table = self._run(base, candidates, u, yy, splits, "grid", bar)
                 else:
+                    self._check_kept_partition(base)
                     table = self._adaptive(base, order_grid, u, yy, splits, bar)
             finally:
                 if bar is not None:
@@ -692,8 +697,17 @@ class PWARXSearch(BaseEstimator):
                                           + (f" (first failure: {errors[0]})" if errors else ""))
         else:
             keep = order_grid
+            ranked_orders = []
             table.extend(self._run(base, [{**order_grid[0], **arx}], u, y, splits, "regions", bar))
             self._decide_scoring(table)
+        if fixed is not None and fixed >= 2:
+            most = max(self._room(base, o, u, splits) for o in [*keep, *ranked_orders] or [{}])
+            if most < fixed:  # no order holds that many regions: said, not a model with fewer
+                n_train = min(len(tr) for tr, _ in splits)
+                raise ParameterError(
+                    f"PWARXSearch: n_regions={fixed}: expected at most {max(most, 1)} for the {n_train} training "
+                    f"rows of each cross-validation split ({ROWS_PER_PARAMETER} rows a parameter of each "
+                    f"region's model), got {fixed}")
         methods = self._methods()
         survivors = list(methods)
         # the refinement of a failed split joins the race only where both methods it combines are
@@ -784,6 +798,33 @@ class PWARXSearch(BaseEstimator):
         table.extend(self._modes_stage(base, table, u, y, splits, bar))
         table.extend(self._powers_stage(base, table, u, y, splits, bar))
         return table
+
+    def _check_kept_partition(self, base) -> None:
+        """The adaptive search chooses the method and the number of regions: an estimator whose
+        own (not PWARX's defaults) the search would replace is refused, saying how to keep them
+        (``PWARXSearch(PWARX(segmentation="threshold", n_regions=3))`` returned an alternating
+        model of 2 regions; with hyperplanes every candidate failed)."""
+        from hwpts.identification.pwarx import PWARX
+        from hwpts.identification.segmentation import Segmenter
+
+        default = PWARX()
+        methods = self._methods()
+        if base.hyperplanes is not None or base.segmentation in ("hyperplane", "average", "zscore"):
+            raise ParameterError(
+                f"PWARXSearch: the estimator's segmentation {base.segmentation!r} fixes its partition, which the "
+                f"adaptive search would replace; to choose only its orders give param_grid (e.g. "
+                f"{{'output_order': [1, 2, 3]}}), or fit the PWARX alone")
+        named = base.segmentation if isinstance(base.segmentation, str) else getattr(base.segmentation, "name", None)
+        chosen = {m if isinstance(m, str) else getattr(m, "name", None) for m in methods}
+        if (isinstance(base.segmentation, Segmenter) or base.segmentation != default.segmentation) \
+                and named not in chosen:
+            raise ParameterError(
+                f"PWARXSearch: the estimator's segmentation {named!r} is not among the methods the search chooses "
+                f"from ({sorted(chosen)}); give methods=[{named!r}] to keep it")
+        if base.n_regions != default.n_regions and self._fixed() != base.n_regions:
+            raise ParameterError(
+                f"PWARXSearch: the estimator's n_regions={base.n_regions!r} would be replaced by the search's "
+                f"n_regions={self.n_regions!r}; give PWARXSearch(..., n_regions={base.n_regions!r}) to keep it")
 
     def _fixed(self):
         """The number of regions the user fixed (``n_regions``), or ``None``."""
