@@ -264,6 +264,24 @@ def test_the_librarys_default_search_is_the_commands_default(tmp_path, capsys):
     assert given.best_estimator_.structure_.nk == (1,)
 
 
+def test_a_partition_column_of_a_long_lag_carries_the_orders_that_hold_it(tmp_path, capsys):
+    """``--partition-column "u(k-3)"`` with the orders searched: the ARX models (no partition)
+    rank the orders, and the orders carried to the regions are those whose regressor holds the
+    column (three carried orders without it made every candidate fail)."""
+    rng = np.random.default_rng(2)
+    u = rng.uniform(-1, 1, 600)
+    y = np.zeros(600)
+    for k in range(3, 600):
+        y[k] = 0.6 * y[k - 1] + u[k - 1] + (0.8 if u[k - 3] > 0 else -0.3) * u[k - 2] + 0.01 * rng.standard_normal()
+    path = tmp_path / "lag.csv"
+    write_csv(path, {"u": u, "y": y})
+    assert main(["identify", str(path), "--input", "u", "--output", "y", "--regions", "2",
+                 "--partition-column", "u(k-3)", "--out", str(tmp_path / "m.json")]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert not [r for r in summary["candidates"] if r["error"]]
+    assert summary["choice"]["nk"][0] + summary["choice"]["nb"][0] - 1 >= 3  # u(k-3) in the regressor
+
+
 def test_identify_says_how_it_ranked_the_orders(tmp_path, capsys):
     """Three modes behind oblique boundaries: no ARX model explains them, a nearest-neighbour
     predictor does, and the orders it predicts best with (the true 1/1/1) are chosen; the summary

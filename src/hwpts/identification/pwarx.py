@@ -341,7 +341,9 @@ class PWARX(BaseEstimator):
                 raise DataError(f"{target.shape[0]} regressor rows are left after the breaks {list(breaks)}: "
                                 f"too few to fit")
         pcols = None
-        if self.partition_columns is not None:
+        if self.partition_columns is not None and (segmenter.learns_partition or segmenter.restricts_columns):
+            # (a fixed partition or a single model has no boundary to restrict: the model search's
+            # ARX candidates of orders without the column ranked the orders, not failed)
             wanted = self.partition_columns
             wanted = (wanted,) if isinstance(wanted, str) else wanted  # one name is one column, not its letters
             pcols = sorted({structure.column_index(c) for c in wanted})

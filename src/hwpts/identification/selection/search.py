@@ -679,6 +679,13 @@ class PWARXSearch(BaseEstimator):
                     if np.isfinite(self._score(r))]
             ranked_orders = keep
             keep = self._carried_orders(base, keep, rows, u, y, splits)
+            if base.partition_columns is not None:
+                # the carried orders whose regressor holds the partition columns, topped up from the
+                # ARX ranking (a column u(k-4) carried three orders without it: every split failed)
+                usable = [o for o in [*keep, *ranked_orders] if self._holds_columns(base, o, u.shape[1])]
+                usable = [o for i, o in enumerate(usable) if o not in usable[:i]]
+                if usable:
+                    keep = usable[:max(len(keep), 1)]
             if fixed is not None and fixed >= 2:
                 # a fixed count: the carried orders whose local models that many regions can hold
                 # (3 rows a parameter), topped up from the ARX ranking (--regions 26 on 300 rows: the
@@ -1140,6 +1147,24 @@ class PWARXSearch(BaseEstimator):
 
         powers = check_output_powers(orders.get("output_powers", base.output_powers))
         return int(na + int(np.sum(nb)) + 1 + len(powers))
+
+    def _holds_columns(self, base, orders, n_inputs) -> bool:
+        """Whether the regressor of these orders has every one of ``base.partition_columns``."""
+        from hwpts.identification.regressors import RegressorStructure, default_input_names
+
+        names, oname = self._names
+        wanted = base.partition_columns
+        wanted = (wanted,) if isinstance(wanted, str) else tuple(wanted)
+        na, nb, nk = self._orders_of(base, orders)
+        try:
+            st = RegressorStructure.create(na, nb, nk, n_inputs, base.constant,
+                                           names if names is not None else default_input_names(n_inputs),
+                                           oname or "y", orders.get("output_powers", base.output_powers))
+            for c in wanted:
+                st.column_index(c)
+        except ParameterError:
+            return False
+        return True
 
     def _rank(self, table):
         order = sorted(range(len(table)), key=lambda i: -self._score(table[i]))
