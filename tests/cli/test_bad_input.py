@@ -266,6 +266,8 @@ CASES = [
      "--output-powers 2,3: the power terms are of y(k-1), which --na 0 leaves out"),
     (["identify", f"{W}/data.csv", *FIXED, "--unit", "mm", "--out", f"{W}/m.json"], "--unit"),
     (["identify", f"{W}/data.csv", *FIXED, "--unit", "q=mm", "--out", f"{W}/m.json"], "--unit"),
+    (["identify", f"{W}/data.csv", *FIXED, "--unit", "y=mm", "--unit", "y=m", "--out", f"{W}/m.json"],
+     "--unit 'y=m': 'y' was given the unit 'mm' already"),
     # --- identify: the output path
     (["identify", f"{W}/data.csv", *FIXED, "--out", f"{W}/folder"], "folder"),
     (["identify", f"{W}/data.csv", *FIXED, "--out", f"{W}/afile/m.json"], "afile"),

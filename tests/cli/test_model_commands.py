@@ -642,6 +642,11 @@ def test_a_column_whose_name_says_another_unit_than_the_models_is_refused(tmp_pa
     assert main(["identify", str(tmp_path / "y.csv"), "--input", "u1", "--input", "u2", "--output", "y", "--unit", "y=rpm",
                  "--na", "2", "--nb", "2", "--segmentation", "average", "--out", str(tmp_path / "y.json")]) == 0
     assert main(["validate", str(tmp_path / "y.json"), str(tmp_path / "y.csv"), "--output", "speed_rpm"]) == 0
+    # identify refuses what validate would: a known unit against the one the column's name says
+    _expect_error(capsys, ["identify", str(tmp_path / "y.csv"), "--input", "u1", "--input", "u2", "--output",
+                           "speed_rpm", "--unit", "speed_rpm=rad/s", "--na", "2", "--nb", "2", "--segmentation",
+                           "average", "--out", str(tmp_path / "r.json")],
+                  "--unit 'speed_rpm=rad/s': the column's name says its unit is 'r/min'")
 
 
 def test_a_missing_cell_outside_the_selected_rows_does_not_matter(tmp_path, capsys):

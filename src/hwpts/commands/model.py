@@ -250,8 +250,9 @@ def _unit_of(name: str) -> str | None:
 
 
 def _units(names, given) -> dict:
-    """Units of the named signals: ``--unit NAME=UNIT`` first, else from the name's suffix."""
-    units = {}
+    """Units of the named signals: ``--unit NAME=UNIT`` (once a signal, and agreeing with a unit
+    its name's suffix says), else from the name's suffix."""
+    units, told = {}, {}
     for name in names:
         unit = _unit_of(name)
         if unit is not None:
@@ -260,9 +261,19 @@ def _units(names, given) -> dict:
         name, sep, unit = str(text).partition("=")
         if not sep or not name.strip() or not unit.strip():
             raise ParameterError(f"--unit expects NAME=UNIT (e.g. y=mm), got {text!r}")
-        if name.strip() not in names:
-            raise ParameterError(f"--unit {text!r}: {name.strip()!r} is not one of the signals {list(names)}")
-        units[name.strip()] = unit.strip()
+        name, unit = name.strip(), unit.strip()
+        if name not in names:
+            raise ParameterError(f"--unit {text!r}: {name!r} is not one of the signals {list(names)}")
+        if name in told:
+            raise ParameterError(f"--unit {text!r}: {name!r} was given the unit {told[name]!r} already; "
+                                 f"expected one --unit per signal")
+        said = _unit_of(name)
+        known = {*UNIT_SUFFIXES.values(), *(f"{u}/s" for u in UNIT_SUFFIXES.values())}
+        if said is not None and unit in known and said != unit:  # as validate refuses a column named in another
+            # unit; free text ("rpm") is not compared
+            raise ParameterError(f"--unit {text!r}: the column's name says its unit is {said!r}; expected "
+                                 f"{said!r} (or no --unit for it), got {unit!r}")
+        told[name] = units[name] = unit
     return units
 
 
