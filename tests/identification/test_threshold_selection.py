@@ -776,3 +776,17 @@ def test_a_fixed_count_prefers_the_models_that_kept_every_region():
     kept = made_up_row({"segmentation": "threshold", "n_regions": 3}, splits, 80.0, 90.0)
     order = search._preference(PWARX(1, 1, 1), [arx, dropped, kept], np.zeros((10, 1)))
     assert order == [kept, dropped]
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"param_grid": {"n_regions": 3}}, r"param_grid\['n_regions'\] must be a list of candidate values \(e.g. \[3\]\), got 3"),
+    ({"param_grid": "n_regions"}, "param_grid must be a dict of lists or a list of dicts, got 'n_regions'"),
+    ({"param_grid": [3]}, "param_grid must be a dict of lists or a list of dicts, got an item 3"),
+    ({"estimator": "PWARX"}, "PWARXSearch: estimator must be a PWARX"),
+])
+def test_a_malformed_grid_or_estimator_is_one_line(kwargs, match):
+    """A scalar where the grid takes a list (GridSearchCV's rule) gave numpy's 'int object is not
+    iterable'; a string as the estimator, scikit-learn's clone error."""
+    u, y = setar(300, 0)
+    with pytest.raises(ParameterError, match=match):
+        PWARXSearch(**kwargs).fit(u, y)

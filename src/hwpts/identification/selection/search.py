@@ -161,9 +161,17 @@ def expand_grid(grid) -> list[dict]:
     lists gives the union; a list of plain dicts is returned as it is."""
     if isinstance(grid, dict):
         keys = list(grid)
+        for k in keys:  # GridSearchCV's rule: each value a list of candidates
+            if isinstance(grid[k], (str, bytes, dict)) or not hasattr(grid[k], "__iter__"):
+                raise ParameterError(f"param_grid[{k!r}] must be a list of candidate values (e.g. [{grid[k]!r}]), "
+                                     f"got {grid[k]!r}")
         return [dict(zip(keys, values)) for values in itertools.product(*(grid[k] for k in keys))]
+    if isinstance(grid, (str, bytes)) or not hasattr(grid, "__iter__"):
+        raise ParameterError(f"param_grid must be a dict of lists or a list of dicts, got {grid!r}")
     out = []
     for item in grid:
+        if not isinstance(item, dict):
+            raise ParameterError(f"param_grid must be a dict of lists or a list of dicts, got an item {item!r}")
         if isinstance(item, dict) and item and all(isinstance(v, (list, tuple)) for v in item.values()):
             out.extend(expand_grid(item))
         else:
@@ -876,7 +884,11 @@ class PWARXSearch(BaseEstimator):
         """One line naming the parameter, what it takes and what it got, before any fit."""
         from hwpts.identification.settings import check_bool, check_count, check_number, is_count
 
+        from hwpts.identification.pwarx import PWARX
+
         owner = "PWARXSearch: "
+        if self.estimator is not None and not isinstance(self.estimator, PWARX):
+            raise ParameterError(f"PWARXSearch: estimator must be a PWARX (or None), got {self.estimator!r}")
         for name in ("tolerance", "n_standard_errors", "refit_margin"):
             check_number(getattr(self, name), name, owner=owner)
         for name in ("n_orders", "patience"):
