@@ -8,7 +8,7 @@ from sklearn.base import clone
 
 from hwpts.dataset import IODataset
 from hwpts.errors import DataError, ParameterError
-from hwpts.identification import PWARX, RegionWarning, fit_percent, region_accuracy
+from hwpts.identification import PWARX, PWARXSearch, RegionWarning, fit_percent, region_accuracy
 from hwpts.identification.local_models import fit_local_models
 from hwpts.identification.synthetic import make_system
 
@@ -409,6 +409,12 @@ def test_a_dataset_at_another_sample_time_is_refused():
     fast = IODataset(t / 4, d.inputs, d.output, ("u1", "u2"), "y")
     with pytest.raises(DataError, match="sample time 0.0025 s differs from the model's 0.01 s"):
         model.simulate(fast)
+    # a sample_time beside a dataset: its own step, or refused (it replaced the dataset's, whose
+    # data score then refused)
+    assert PWARX(2, 2, 1, n_regions=1, segmentation="average").fit(train, sample_time=0.01).sample_time_ == 0.01
+    for estimator in (PWARX(2, 2, 1, n_regions=1, segmentation="average"), PWARXSearch(PWARX(2, 2, 1), max_regions=1)):
+        with pytest.raises(ParameterError, match="sample_time 0.5 s differs from the dataset's time, sampled every 0.01 s"):
+            estimator.fit(train, sample_time=0.5)
 
 
 def test_search_and_polish_run_blas_single_threaded(monkeypatch):

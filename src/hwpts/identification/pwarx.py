@@ -304,9 +304,7 @@ class PWARX(BaseEstimator):
         ``{signal name: unit}`` kept for plots and exports. Returns ``self``.
         """
         if isinstance(X, IODataset):
-            uniform = X.uniform_sample_time("the dataset's time", LIBRARY_REMEDY)
-            if sample_time is None:
-                sample_time = uniform
+            sample_time = dataset_sample_time(X, sample_time)
         check_fit_arguments(sample_time, units, output_name)
         self._check_settings()
         u, yy, names, oname = self._signals(X, y, input_names, output_name)
@@ -636,6 +634,21 @@ class PWARX(BaseEstimator):
 
 LIBRARY_REMEDY = ("resample it, or fit the arrays with breaks at the gaps: "
                   "fit(data.inputs, data.output, breaks=[...])")
+
+
+def dataset_sample_time(data, sample_time):
+    """The sample time [s] to keep for a fit on the IODataset ``data``: its time's step, or
+    ``sample_time`` when given and equal to it within 1 % (another one is refused: it replaced the
+    dataset's and then its own data were refused by ``score`` as sampled at another rate)."""
+    from hwpts.identification.settings import is_number
+
+    uniform = data.uniform_sample_time("the dataset's time", LIBRARY_REMEDY)
+    if sample_time is None:
+        return uniform
+    if uniform is not None and is_number(sample_time, strict=True) and abs(sample_time - uniform) > 0.01 * uniform:
+        raise ParameterError(f"sample_time {sample_time!r} s differs from the dataset's time, sampled every "
+                             f"{uniform:g} s; expected that or sample_time left out")
+    return sample_time
 
 
 def check_fit_arguments(sample_time, units, output_name) -> None:

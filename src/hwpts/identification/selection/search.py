@@ -591,11 +591,9 @@ class PWARXSearch(BaseEstimator):
         from hwpts.dataset import IODataset
 
         if isinstance(X, IODataset):
-            from hwpts.identification.pwarx import LIBRARY_REMEDY
+            from hwpts.identification.pwarx import dataset_sample_time
 
-            uniform = X.uniform_sample_time("the dataset's time", LIBRARY_REMEDY)
-            if sample_time is None:
-                sample_time = uniform
+            sample_time = dataset_sample_time(X, sample_time)
         from hwpts.identification.pwarx import check_fit_arguments
 
         check_fit_arguments(sample_time, units, output_name)
