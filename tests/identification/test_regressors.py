@@ -35,7 +35,7 @@ def test_extended_regressor_has_constant():
 
 def test_too_short_names_the_need():
     st = RegressorStructure.create(5, 4, 0, 2)
-    with pytest.raises(DataError, match=r"na=5, nb=4, nk=0 needs at least 19 samples .*DATA has 7 rows"):
+    with pytest.raises(DataError, match=r"na=5, nb=4, nk=0 needs at least 19 samples .*the data has 7 rows"):
         st.build(np.zeros((7, 2)), np.zeros(7))
 
 

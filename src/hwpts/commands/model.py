@@ -739,7 +739,7 @@ def _merged(kind: str, details: list[dict]) -> str:
 def _validate_numbers(model, data):
     from hwpts.identification.metrics import fit_percent, rmse
 
-    model.structure_.check_length(data.n_samples)
+    model.structure_.check_length(data.n_samples, what="DATA")
     m = model.structure_.max_lag
     y = data.output[m:]
     sim = model.simulate(data.inputs, data.output)
@@ -850,7 +850,7 @@ def cmd_predict(args) -> int:
     from hwpts.io.datasets import is_stdout, write_table
 
     model, data = _model_and_data(args)
-    model.structure_.check_length(data.n_samples)
+    model.structure_.check_length(data.n_samples, what="DATA")
     name = data.output_name
     written = ("time_s", f"{name}_predicted", "region")
     clash = [nm for nm in (*data.input_names, name) if nm in written]

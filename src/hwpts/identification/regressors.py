@@ -184,7 +184,7 @@ class RegressorStructure:
         powers = f", output powers {list(self.output_powers)}" if self.output_powers else ""
         return f"na={self.na}, nb={nb}, nk={nk}{powers}"
 
-    def check_length(self, n_samples: int, what: str = "DATA") -> None:
+    def check_length(self, n_samples: int, what: str = "the data") -> None:
         """Raise :class:`DataError` when ``n_samples`` is too short for these orders."""
         if n_samples < self.min_samples:
             raise DataError(
