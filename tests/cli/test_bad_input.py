@@ -242,6 +242,8 @@ CASES = [
       "--out", f"{W}/m.json"], "--hyperplane"),
     (["identify", f"{W}/data.csv", *FIT, "--na", "2", "--nb", "2", "--segmentation", "kmeans", "--regions", "2",
       "--zero-region", "9", "--out", f"{W}/m.json"], "--zero-region"),
+    (["identify", f"{W}/data.csv", *FIT, "--na", "2", "--nb", "2", "--segmentation", "kmeans", "--regions", "1",
+      "--zero-region", "1", "--out", f"{W}/m.json"], "--zero-region: expected at most 0 of the 1 regions"),
     (["identify", f"{W}/data.csv", *FIXED, "--ridge", "-1", "--out", f"{W}/m.json"], "--ridge"),
     (["identify", f"{W}/data.csv", *FIXED, "--ridge", "inf", "--out", f"{W}/m.json"], "--ridge"),
     (["identify", f"{W}/data.csv", *FIXED, "--seed", "-1", "--out", f"{W}/m.json"], "--seed"),

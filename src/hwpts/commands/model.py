@@ -603,6 +603,9 @@ def cmd_identify(args) -> int:
             if not 1 <= r <= n_hyper:
                 raise ParameterError(f"--zero-region {r}: regions are numbered 1..{n_hyper}")
             region_models[r - 1] = "zero"
+        if all(kind == "zero" for kind in region_models):  # a model y = 0 everywhere: nothing is fitted
+            raise ParameterError(f"--zero-region: expected at most {n_hyper - 1} of the {n_hyper} regions as the "
+                                 f"zero mode y = 0 (every one leaves nothing to fit), got {len(set(args.zero_region))}")
     fixed_partition = segmentation in ("hyperplane", "average", "zscore")
     model = PWARX(
         **{"output_order": 1, "input_order": 1, "input_delay": 1, **fixed},
