@@ -94,7 +94,13 @@ def _scaled(X: np.ndarray, constant: bool):
     mean = X.mean(axis=0) if constant and n else np.zeros(X.shape[1])
     A = X - mean if constant and n else X
     scale = np.sqrt(np.mean(A**2, axis=0)) if n else np.ones(X.shape[1])
-    scale[~(scale > 1e-300)] = 1.0
+    # a column constant in the region (an input held over all its rows) is zero once centred, not
+    # its rounding scaled up to unit size and fitted as a regressor
+    flat = ~(scale > 1e-12 * np.sqrt(np.mean(X**2, axis=0))) if n else np.zeros(X.shape[1], dtype=bool)
+    if flat.any():
+        A = A.copy() if A is X else A
+        A[:, flat] = 0.0
+    scale[flat | ~(scale > 1e-300)] = 1.0
     return A / scale, scale, mean
 
 
