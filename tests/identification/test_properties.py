@@ -177,3 +177,20 @@ def test_local_least_squares_is_the_scaled_ridge_solution(n, n_features, n_regio
         np.testing.assert_allclose(got[-1], ym - xm @ slopes if constant else 0.0, rtol=1e-6, atol=1e-8)
         if constant:  # offsets move the intercept alone
             np.testing.assert_allclose(shifted.theta[i, :-1] * scale, got[:-1] * scale, rtol=1e-6, atol=1e-7)
+
+
+def test_a_column_constant_over_a_region_gets_no_weight():
+    """An input held over every row of a region: once centred its column is zero (to rounding), and
+    the minimum-norm solution gives it no weight, at any offset (its rounding, scaled up to unit
+    size, had been fitted as a regressor: a gain of -0.020 on textbook's ``oversampled``)."""
+    from hwpts.identification.local_models import fit_local_models
+
+    rng = np.random.default_rng(0)
+    y1 = rng.standard_normal(40)
+    for held in (0.3, 0.56948233, 1e4 + 0.1):
+        X = np.column_stack([y1, np.full(40, held)])
+        y = 0.9 * y1 + 0.01 * rng.standard_normal(40)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            theta = fit_local_models(X, y, np.zeros(40, dtype=np.int64), 1).theta[0]
+        assert theta[1] == 0.0 and abs(theta[0] - 0.9) < 0.01
