@@ -154,6 +154,13 @@ def test_pandas_records_read_by_position_are_refused_where_position_is_wrong():
         model.predict(X, Y.sample(frac=1.0, random_state=0))
     with pytest.raises(DataError, match="time index is not increasing"):
         PWARX(1, 1, 1).fit(X.iloc[::-1], Y.iloc[::-1])
+    plain = pd.DataFrame({"u": u[:, 0], "y": y})  # a RangeIndex, then shuffled (df.sample)
+    PWARX(1, 1, 1, segmentation="average", n_regions=1).fit(plain[["u"]], plain["y"])
+    shuffled = plain.sample(frac=1.0, random_state=0)
+    with pytest.raises(DataError, match=r"X's index is not increasing \(rows are read in order"):
+        PWARX(1, 1, 1).fit(shuffled[["u"]], shuffled["y"])
+    with pytest.raises(DataError, match="index is not increasing"):
+        model.score(shuffled[["u"]], shuffled["y"])
     with pytest.raises(DataError, match="holds dates or durations"):
         PWARX(1, 1, 1).fit(pd.DataFrame({"u": index}), y)
 
