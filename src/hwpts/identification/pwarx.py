@@ -227,6 +227,11 @@ class PWARX(BaseEstimator):
         u, yy = validate_signals(_as_array(X), _output_vector(y))
         return u, yy, names, output_name
 
+    def partition_column_names(self) -> tuple[str, ...] | None:
+        """``partition_columns`` as a tuple of names (one name is one column, not its letters)."""
+        wanted = self.partition_columns
+        return None if wanted is None else (wanted,) if isinstance(wanted, str) else tuple(wanted)
+
     def given_orders(self) -> tuple:
         """``(na, nb, nk)`` this model is fitted with: its orders, 1 for each left ``None``."""
         return tuple(1 if v is None else v for v in (self.output_order, self.input_order, self.input_delay))
@@ -339,12 +344,10 @@ class PWARX(BaseEstimator):
                 raise DataError(f"{target.shape[0]} regressor rows are left after the breaks {list(breaks)}: "
                                 f"too few to fit")
         pcols = None
-        if self.partition_columns is not None and (segmenter.learns_partition or segmenter.restricts_columns):
-            # (a fixed partition or a single model has no boundary to restrict: the model search's
+        if self.partition_columns is not None and not segmenter.given_partition():
+            # (a given partition or a single model has no boundary to restrict: the model search's
             # ARX candidates of orders without the column ranked the orders, not failed)
-            wanted = self.partition_columns
-            wanted = (wanted,) if isinstance(wanted, str) else wanted  # one name is one column, not its letters
-            pcols = sorted({structure.column_index(c) for c in wanted})
+            pcols = sorted({structure.column_index(c) for c in self.partition_column_names()})
         if segmenter.uses_n_regions and isinstance(self.n_regions, (int, np.integer)) \
                 and not isinstance(self.n_regions, bool) and self.n_regions > X_reg.shape[0] // (structure.n_features + 2):
             raise ParameterError(

@@ -56,6 +56,13 @@ class Segmenter(BaseEstimator):
     #: ``segment`` takes ``columns=`` (the indices a PWARX's ``partition_columns`` allows)
     restricts_columns = False
 
+    @classmethod
+    def given_partition(cls) -> bool:
+        """Whether the partition is the user's or the method's own rule (``average``, ``zscore``,
+        ``hyperplane``), not one found on the data: no boundary to restrict to columns, none for
+        a model search to choose."""
+        return not (cls.learns_partition or cls.restricts_columns)
+
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:  # pragma: no cover
         """Assign the regressor rows ``X`` with targets ``y`` to ``n_regions`` regions; returns a :class:`SegmentationResult` (labels, and a partition when the method defines one)."""
         raise NotImplementedError

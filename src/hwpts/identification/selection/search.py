@@ -172,7 +172,7 @@ def expand_grid(grid) -> list[dict]:
     for item in grid:
         if not isinstance(item, dict):
             raise ParameterError(f"param_grid must be a dict of lists or a list of dicts, got an item {item!r}")
-        if isinstance(item, dict) and item and all(isinstance(v, (list, tuple)) for v in item.values()):
+        if item and all(isinstance(v, (list, tuple)) for v in item.values()):
             out.extend(expand_grid(item))
         else:
             out.append(dict(item))
@@ -822,7 +822,7 @@ class PWARXSearch(BaseEstimator):
 
         default = PWARX()
         methods = self._methods()
-        if base.hyperplanes is not None or base.segmentation in ("hyperplane", "average", "zscore"):
+        if base.hyperplanes is not None or base._segmenter().given_partition():
             raise ParameterError(
                 f"PWARXSearch: the estimator's segmentation {base.segmentation!r} fixes its partition, which the "
                 f"adaptive search would replace; to choose only its orders give param_grid (e.g. "
@@ -880,9 +880,8 @@ class PWARXSearch(BaseEstimator):
 
     def _check_params(self):
         """One line naming the parameter, what it takes and what it got, before any fit."""
-        from hwpts.identification.settings import check_bool, check_count, check_number, is_count
-
         from hwpts.identification.pwarx import PWARX
+        from hwpts.identification.settings import check_bool, check_count, check_number, is_count
 
         owner = "PWARXSearch: "
         if self.estimator is not None and not isinstance(self.estimator, PWARX):
@@ -1163,8 +1162,7 @@ class PWARXSearch(BaseEstimator):
         from hwpts.identification.regressors import RegressorStructure, default_input_names
 
         names, oname = self._names
-        wanted = base.partition_columns
-        wanted = (wanted,) if isinstance(wanted, str) else tuple(wanted)
+        wanted = base.partition_column_names()
         na, nb, nk = self._orders_of(base, orders)
         try:
             st = RegressorStructure.create(na, nb, nk, n_inputs, base.constant,
