@@ -586,10 +586,13 @@ def cmd_identify(args) -> int:
         raise ParameterError(f"--regions {n_regions}: expected at most {int(np.ceil(1 / share)) - 1} for "
                              f"--segmentation {segmentation} (a threshold split leaves each region at least "
                              f"{100 * share:g} % of the rows), got {n_regions}")
-    if segmentation not in ("hyperplane", "average", "zscore") and searched and fixed:
+    # a given partition (the user's hyperplanes, average's one region, zscore's rule): neither
+    # learned nor drawn on the data, so no count to check against the rows and no method to choose
+    fixed_partition = segmentation in SEGMENTATION_METHODS and SEGMENTATION_METHODS[segmentation].given_partition()
+    if not fixed_partition and searched and fixed:
         # (a fixed partition's grid search splits by the given orders' lags alone)
         _check_fixed_lags(fixed, searched, data.n_samples, _selection(args, repr(str(args.data))))
-    if segmentation not in ("hyperplane", "average", "zscore"):
+    if not fixed_partition:
         _check_region_count(n_regions, data.n_samples, fixed, searched, len(args.input),
                             searching=bool(searched) or segmentation == "auto",
                             powers=given_powers)
@@ -606,7 +609,6 @@ def cmd_identify(args) -> int:
         if all(kind == "zero" for kind in region_models):  # a model y = 0 everywhere: nothing is fitted
             raise ParameterError(f"--zero-region: expected at most {n_hyper - 1} of the {n_hyper} regions as the "
                                  f"zero mode y = 0 (every one leaves nothing to fit), got {len(set(args.zero_region))}")
-    fixed_partition = segmentation in ("hyperplane", "average", "zscore")
     model = PWARX(
         **{"output_order": 1, "input_order": 1, "input_delay": 1, **fixed},
         n_regions=n_regions if isinstance(n_regions, int) else 2,
