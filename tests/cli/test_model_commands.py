@@ -178,6 +178,27 @@ def test_mat_with_the_variables_works(tmp_path, capsys):
     assert json.loads(capsys.readouterr().out)["n_regions"] == 1
 
 
+def test_mat_sample_time_variable(tmp_path, capsys):
+    """A .mat file's scalar Ts (as MATLAB's iddata) is its sample time when it has no time column;
+    a time column that disagrees with it, or a Ts that is no period, is refused."""
+    d = make_system(5, rng=2, n=400)
+    signals = {"u1": d.inputs[:, :1], "u2": d.inputs[:, 1:], "y": d.output[:, None]}
+    path, out = tmp_path / "d.mat", tmp_path / "m.json"
+    savemat(path, {**signals, "Ts": np.array([[0.05]])})
+    assert main(["identify", str(path), *IDENTIFY, "--segmentation", "average", "--out", str(out)]) == 0
+    assert json.loads(capsys.readouterr().out)["sample_time_s"] == 0.05
+    assert main(["identify", str(path), *IDENTIFY, "--segmentation", "average", "--time", "none",
+                 "--out", str(tmp_path / "n.json")]) == 0
+    assert json.loads(capsys.readouterr().out)["sample_time_s"] is None
+    out = tmp_path / "refused.json"
+    savemat(path, {**signals, "Ts": np.array([[0.05]]), "t": 0.1 * np.arange(400)[:, None]})
+    _expect_error(capsys, ["identify", str(path), *IDENTIFY, "--segmentation", "average", "--out", str(out)],
+                  "the time column 't' is sampled every 0.1 s but the variable 'Ts' says 0.05 s", out)
+    savemat(path, {**signals, "dt": np.array([[0.0]])})
+    _expect_error(capsys, ["identify", str(path), *IDENTIFY, "--segmentation", "average", "--out", str(out)],
+                  "the variable 'dt' is taken as the sample time in seconds; expected a positive number, got 0", out)
+
+
 def test_bad_arguments(tmp_path, data_csv, capsys):
     out = tmp_path / "m.json"
     _expect_error(capsys, ["identify", str(data_csv), *IDENTIFY, "--segmentation", "nope", "--out", str(out)],

@@ -65,6 +65,9 @@ def _rows(text: str | None):
 # conventional names of a time column in seconds, tried in this order when --time is not given
 TIME_COLUMNS = ("time_s", "t_s", "time", "t")
 NO_TIME = "none"  # --time none: no time column, the sample index is the time axis
+# a .mat file's scalar variable that gives the sample period in seconds (as MATLAB's iddata Ts),
+# tried in this order when the file has no time column and --time is not given
+MAT_SAMPLE_TIMES = ("Ts", "ts", "dt", "sample_time", "sample_time_s")
 
 
 def _available(path, found) -> str:
@@ -144,6 +147,7 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
             raise DataError(f"{str(path)!r}: column {name!r} has a non-finite value (NaN, inf or an empty cell) at "
                             f"row {offset + int(np.argmax(bad))} (data rows count from 0 after the header, as --rows)")
     tname = next((c for c in candidates if c in cols), None)
+    period = _mat_sample_time(path, columns) if time_name is None else None
     detected = time_name is None and tname is not None
     hint = f" ({tname!r} is taken as the time column by its name; --time none uses the sample index)" if detected else ""
     timed = tname is not None
@@ -151,8 +155,9 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
         # a column of numbers named in ms (time_ms), minutes, ...; a typed Parquet time is in seconds already
         cols[tname] = np.asarray(cols[tname], dtype=float) * time_seconds(tname)
     if tname is None:
-        # time = sample index of the file (keeps the original numbering under --rows)
-        cols["__index__"] = np.arange(len(columns[output_name]), dtype=float)[sl]
+        # time = sample index of the file (keeps the original numbering under --rows), in seconds
+        # when a .mat file gives its sample period
+        cols["__index__"] = np.arange(len(columns[output_name]), dtype=float)[sl] * (period[1] if period else 1.0)
         tname = "__index__"
     try:
         data = IODataset.from_columns(cols, list(input_names), output_name, time_name=tname)
@@ -163,7 +168,33 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
         dt = _sample_time(data, path, tname) if timed else None
     except DataError as error:
         raise DataError(f"{error}{hint}") from None
+    if period is not None:
+        name, value = period
+        if dt is None:
+            dt = value
+        elif abs(dt - value) > SAMPLE_TIME_TOLERANCE * value:
+            raise DataError(f"{str(path)!r}: the time column {tname!r} is sampled every {dt:.6g} s but the variable "
+                            f"{name!r} says {value:.6g} s; correct one of them, or pass --time none or --time COL")
     return data, dt
+
+
+def _mat_sample_time(path, columns) -> tuple[str, float] | None:
+    """``(name, seconds)`` of a .mat file's scalar sample-period variable (:data:`MAT_SAMPLE_TIMES`),
+    or None; a scalar of that name that is not a positive finite number is refused."""
+    from pathlib import Path
+
+    if Path(path).suffix.lower() != ".mat":
+        return None
+    for name in MAT_SAMPLE_TIMES:
+        value = columns.get(name)
+        if value is None or np.size(value) != 1:
+            continue
+        value = float(np.asarray(value, dtype=float).reshape(-1)[0])
+        if not (np.isfinite(value) and value > 0):
+            raise DataError(f"{str(path)!r}: the variable {name!r} is taken as the sample time in seconds; expected "
+                            f"a positive number, got {value:g} (pass --time none to use the sample index)")
+        return name, value
+    return None
 
 
 def _selection(args, name: str) -> str:
@@ -821,8 +852,9 @@ def cmd_validate(args) -> int:
     st = model.structure_
     print(f"model: {args.model} ({model.n_regions_} regions, {st.describe_orders()}, "
           f"inputs {list(st.input_names)}, output {st.output_name!r})")
-    print(f"data: {args.data} ({result['n_samples']} samples, first {result['n_initial_conditions']} "
-          f"are initial conditions)")
+    first = result["n_initial_conditions"]
+    print(f"data: {args.data} ({result['n_samples']} samples, "
+          f"{'the first is the initial condition' if first == 1 else f'first {first} are initial conditions'})")
     if result["diverged"]:
         print(f"free-run fit: none - {result['reason']}")
     else:
