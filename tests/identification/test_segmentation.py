@@ -430,7 +430,10 @@ def test_threshold_alternating_names_itself_in_its_errors():
     rng = np.random.default_rng(0)
     u = rng.uniform(-1, 1, 500)
     y = 0.1 * np.cumsum(u)
-    with pytest.raises(ParameterError, match=r"^threshold-alternating: 3 regions cannot each hold min_share=0.5"):
+    with pytest.raises(ParameterError, match=r"^threshold-alternating: 3 regions cannot each hold min_share=0.4"):
+        PWARX(1, 1, 1, n_regions=3, segmentation="threshold-alternating",
+              segmentation_params={"min_share": 0.4}).fit(u, y)
+    with pytest.raises(ParameterError, match=r"^threshold-alternating: min_share must be a number in \(0, 0.5\)"):
         PWARX(1, 1, 1, n_regions=3, segmentation="threshold-alternating",
               segmentation_params={"min_share": 0.5}).fit(u, y)
     with pytest.raises(ParameterError, match=r"^threshold-alternating: max_iter"):

@@ -7,6 +7,7 @@ import pytest
 
 from hwpts.errors import DataError, ParameterError
 from hwpts.identification import PWARX, PWARXSearch, fit_percent
+from hwpts.identification.segmentation import make_segmenter
 
 
 def two_modes(n=600, seed=0):
@@ -219,11 +220,43 @@ def test_a_dataset_with_a_gap_or_jitter_in_time_is_refused(shift):
     ("clustering", {"n_init": 0}, "clustering: n_init must be an int >= 1"),
     ("kmeans", {"n_init": 2.5}, "kmeans: n_init must be an int >= 1"),
     ("kmeans", {"include_output": "yes"}, "kmeans: include_output must be True or False"),
+    ("threshold", {"n_grid": "x"}, "threshold: n_grid must be an int >= 2, got 'x'"),
+    ("threshold", {"n_grid": 2.5}, "threshold: n_grid must be an int >= 2, got 2.5"),
+    ("threshold", {"min_share": "x"}, r"threshold: min_share must be a number in \(0, 0.5\)"),
+    ("threshold", {"column": 3}, "threshold: column must be a regressor column name"),
+    ("threshold-alternating", {"n_grid": None}, "threshold-alternating: n_grid must be an int >= 2, got None"),
+    ("zscore", {"threshold": "a"}, "zscore: threshold must be a finite number"),
+    ("zscore", {"threshold": [0.0]}, "zscore: threshold must be a finite number"),
+    ("hyperplane", {"hyperplanes": "1,0,0"}, "hyperplane: hyperplanes must be a list of 'a,b,c' texts"),
 ])
 def test_segmenter_settings_are_checked(method, params, match):
+    """Every method's settings are said in one line before any fit (numpy's or Python's own errors
+    came out of the threshold's and zscore's, and a string of hyperplanes was read letter by letter)."""
     u, y = two_modes()
     with pytest.raises(ParameterError, match=match):
         PWARX(1, 1, 1, segmentation=method, segmentation_params=params, random_state=0).fit(u, y)
+    segmenter = make_segmenter(method, **params)
+    with pytest.raises(ParameterError, match=match):
+        segmenter.check_params()
+
+
+@pytest.mark.parametrize("estimator, grid, match", [
+    (PWARX(1, 1, 1), {"n_regions": [2, 0]}, r"candidate \{'n_regions': 0\}: n_regions must be an int >= 1, got 0"),
+    (PWARX(1, 1, 1), {"n_regions": [2, "x"]}, "n_regions must be an int >= 1, got 'x'"),
+    (PWARX(1, 1, 1), {"output_order": [1, -2]}, "na \\(output order\\) must be an int >= 0, got -2"),
+    (PWARX(1, 1, 1), {"ridge": [0, -1]}, "ridge must be a number >= 0, got -1"),
+    (PWARX(1, 1, 1), {"segmentation": ["auto"]}, "segmentation 'auto' is the search itself"),
+    (PWARX(1, 1, 1), {"segmentation": ["threshold"], "segmentation_params": [{"n_grid": 1}]},
+     "threshold: n_grid must be an int >= 2, got 1"),
+    (PWARX(-1, 1, 1), None, "^PWARXSearch: na \\(output order\\) must be an int >= 0, got -1"),
+    (PWARX(1, (1, 1), 1), None, "^PWARXSearch: nb \\(input order\\) has 2 entries but there are 1 inputs"),
+])
+def test_a_bad_value_in_the_grid_or_the_estimator_is_said_before_any_fit(estimator, grid, match):
+    """A grid's bad value was fitted, failed, and left out of the choice without a word (an
+    estimator's bad order surfaced as 'every candidate failed', a RuntimeError)."""
+    u, y = two_modes()
+    with pytest.raises(ParameterError, match=match):
+        PWARXSearch(estimator, grid).fit(u, y)
 
 
 def test_one_partition_column_name_is_one_column_and_an_empty_simulation_is_refused():

@@ -274,6 +274,8 @@ class PWARX(BaseEstimator):
             shown = seed if isinstance(seed, (bool, str, bytes, float, int)) else type(seed).__name__
             raise ParameterError(f"random_state must be None, an int >= 0 or a numpy Generator or SeedSequence, "
                                  f"got {shown!r}") from None
+        if not (isinstance(self.segmentation, str) and self.segmentation == "auto"):  # (a search's base may say it)
+            self._segmenter().check_params()  # the method's own settings (segmentation_params)
 
     def _segmenter(self):
         from sklearn.base import clone

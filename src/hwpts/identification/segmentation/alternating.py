@@ -336,9 +336,8 @@ class AlternatingSegmenter(Segmenter):
                 best = end
         return (*preferred_end(best, best_random), objectives)
 
-    def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
-        """Labels from alternating assignment and least squares with restarts (see the module docstring)."""
-        self._check_regions(n_regions, X.shape[0])
+    def check_params(self) -> None:
+        """``n_restarts``, ``gamma``, ``max_iter`` and ``anneal`` (see :meth:`Segmenter.check_params`)."""
         check_count(self.n_restarts, "n_restarts", 1, "alternating: ", allow=("auto",))
         check_number(self.gamma, "gamma", owner="alternating: ")
         check_count(self.max_iter, "max_iter", 1, "alternating: ")
@@ -349,6 +348,11 @@ class AlternatingSegmenter(Segmenter):
         if anneal is None or not all(np.isfinite(a) and a > 0 for a in anneal):
             raise ParameterError(f"alternating: anneal must be a list of numbers > 0 (multiples of gamma), "
                                  f"got {self.anneal!r}")
+
+    def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
+        """Labels from alternating assignment and least squares with restarts (see the module docstring)."""
+        self.check_params()
+        self._check_regions(n_regions, X.shape[0])
         s = n_regions
         n = X.shape[0]
         if s == 1:

@@ -63,6 +63,11 @@ class Segmenter(BaseEstimator):
         a model search to choose."""
         return not (cls.learns_partition or cls.restricts_columns)
 
+    def check_params(self) -> None:
+        """Raise a one-line :class:`ParameterError` naming a setting of this method that is not
+        what it takes (called before any fit, and by :meth:`segment`); the count of regions and the
+        rows are checked where they are used."""
+
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:  # pragma: no cover
         """Assign the regressor rows ``X`` with targets ``y`` to ``n_regions`` regions; returns a :class:`SegmentationResult` (labels, and a partition when the method defines one)."""
         raise NotImplementedError

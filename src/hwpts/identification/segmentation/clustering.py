@@ -85,12 +85,16 @@ class ClusteringSegmenter(Segmenter):
         self.n_neighbors = n_neighbors
         self.n_init = n_init
 
-    def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
-        """Labels from clustering the local-model features of Ferrari-Trecate et al. (see the module docstring)."""
-        self._check_regions(n_regions, X.shape[0])
+    def check_params(self) -> None:
+        """``n_neighbors`` and ``n_init`` (see :meth:`Segmenter.check_params`)."""
         if self.n_neighbors is not None:
             check_count(self.n_neighbors, "n_neighbors", 2, "clustering: ")
         check_count(self.n_init, "n_init", 1, "clustering: ")
+
+    def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
+        """Labels from clustering the local-model features of Ferrari-Trecate et al. (see the module docstring)."""
+        self.check_params()
+        self._check_regions(n_regions, X.shape[0])
         p = X.shape[1] + 1
         c = self.n_neighbors if self.n_neighbors is not None else max(2 * p, p + 3)
         theta, m, V, c = local_features(X, y, c)

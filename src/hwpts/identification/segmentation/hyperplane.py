@@ -74,7 +74,14 @@ class HyperplaneSegmenter(Segmenter):
 
     def parsed(self) -> list[Hyperplane]:
         """The hyperplanes as :class:`Hyperplane` objects (strings parsed)."""
+        if isinstance(self.hyperplanes, (str, bytes, Hyperplane)) or not hasattr(self.hyperplanes, "__iter__"):
+            raise ParameterError(f"hyperplane: hyperplanes must be a list of 'a,b,c' texts or Hyperplane objects "
+                                 f"(one per boundary), got {self.hyperplanes!r}")
         return [hp if isinstance(hp, Hyperplane) else Hyperplane.parse(hp) for hp in self.hyperplanes]
+
+    def check_params(self) -> None:
+        """``hyperplanes``: a list, each one parsed (see :meth:`Segmenter.check_params`)."""
+        self.parsed()
 
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
         """The decision list of the user's hyperplanes as a fixed partition (m hyperplanes, m + 1 regions)."""

@@ -30,11 +30,15 @@ class KMeansSegmenter(Segmenter):
         self.include_output = include_output
         self.n_init = n_init
 
-    def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
-        """Labels from k-means on the standardised regressors."""
-        self._check_regions(n_regions, X.shape[0])
+    def check_params(self) -> None:
+        """``n_init`` and ``include_output`` (see :meth:`Segmenter.check_params`)."""
         check_count(self.n_init, "n_init", 1, "kmeans: ")
         check_bool(self.include_output, "include_output", "kmeans: ")
+
+    def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
+        """Labels from k-means on the standardised regressors."""
+        self.check_params()
+        self._check_regions(n_regions, X.shape[0])
         Z = standardize(np.column_stack([X, y]) if self.include_output else X)
         labels = kmeans_labels(Z, n_regions, rng, self.n_init)
         return SegmentationResult(labels, n_regions, refine=False)

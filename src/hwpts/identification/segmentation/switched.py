@@ -121,7 +121,8 @@ class SwitchedSegmenter(Segmenter):
         self.screen_rows = screen_rows
         self.max_iter = max_iter
 
-    def _check_params(self):
+    def check_params(self) -> None:
+        """The restarts, rows, iterations, margins and ``max_regions`` (see :meth:`Segmenter.check_params`)."""
         for name, low in (("n_restarts", 1), ("screen_rows", 10), ("max_iter", 1)):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
@@ -203,7 +204,7 @@ class SwitchedSegmenter(Segmenter):
 
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
         """Labels of ``n_regions`` modes over the regions each covers (see the module docstring)."""
-        self._check_params()
+        self.check_params()
         self._check_regions(n_regions, X.shape[0])
         K = int(n_regions)
         n = X.shape[0]

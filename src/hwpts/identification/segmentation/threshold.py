@@ -314,6 +314,19 @@ def _cholesky_sse(C, ia, ib, pairs, p, ridge):
     return out
 
 
+def check_split_params(segmenter, owner: str) -> None:
+    """The threshold split's settings (``column``, ``n_grid``, ``min_share``) of ``segmenter``."""
+    from hwpts.identification.settings import check_count, is_number
+
+    if segmenter.column is not None and not isinstance(segmenter.column, str):
+        raise ParameterError(f"{owner}column must be a regressor column name such as 'y(k-1)' or None, "
+                             f"got {segmenter.column!r}")
+    check_count(segmenter.n_grid, "n_grid", 2, owner)
+    if not (is_number(segmenter.min_share, 0.0, strict=True) and segmenter.min_share < 0.5):
+        raise ParameterError(f"{owner}min_share must be a number in (0, 0.5) (each region's least share of "
+                             f"the rows), got {segmenter.min_share!r}")
+
+
 class ThresholdSegmenter(Segmenter):
     """Thresholds on one regressor column chosen by exact least squares (module doc).
 
@@ -340,18 +353,21 @@ class ThresholdSegmenter(Segmenter):
         self.n_grid = n_grid
         self.min_share = min_share
 
+    def check_params(self, owner: str = "threshold: ") -> None:
+        """``column``, ``n_grid`` and ``min_share`` (see :meth:`Segmenter.check_params`)."""
+        check_split_params(self, owner)
+
     def segment(self, X, y, n_regions, structure, rng, columns=None) -> SegmentationResult:
         """The exact least-squares thresholds on the chosen column (or the best column), as a fixed
         partition. ``columns``: the regressor columns a threshold may use (a PWARX's
         ``partition_columns``); default all."""
+        self.check_params()
         self._check_regions(n_regions, X.shape[0])
         if not 0 < self.min_share < 1 / max(n_regions, 2):
             most = int(np.ceil(1 / self.min_share)) - 1 if 0 < self.min_share < 1 else 0
             raise ParameterError(f"threshold: {n_regions} regions cannot each hold min_share={self.min_share} of "
                                  f"the rows: at most {most} regions at that share (min_share must be in "
                                  f"(0, 1/n_regions))")
-        if int(self.n_grid) < 2:
-            raise ParameterError(f"threshold: n_grid must be >= 2, got {self.n_grid}")
         n, nf = X.shape
         allowed = range(nf) if columns is None else sorted({int(c) for c in columns})
         if self.column is None:

@@ -27,7 +27,7 @@ import numpy as np
 from hwpts.errors import IdentificationError, ParameterError
 from hwpts.identification.segmentation.alternating import alternate, scaled_problem
 from hwpts.identification.segmentation.base import SegmentationResult, Segmenter
-from hwpts.identification.segmentation.threshold import ThresholdSegmenter
+from hwpts.identification.segmentation.threshold import ThresholdSegmenter, check_split_params
 from hwpts.identification.settings import check_count, check_number
 
 
@@ -55,10 +55,15 @@ class ThresholdAlternatingSegmenter(Segmenter):
         self.gamma = gamma
         self.max_iter = max_iter
 
-    def segment(self, X, y, n_regions, structure, rng, columns=None) -> SegmentationResult:
-        """The threshold split's labels, alternated to a local minimum; no fixed partition."""
+    def check_params(self) -> None:
+        """The split's settings, ``gamma`` and ``max_iter`` (see :meth:`Segmenter.check_params`)."""
+        check_split_params(self, "threshold-alternating: ")
         check_number(self.gamma, "gamma", owner="threshold-alternating: ")
         check_count(self.max_iter, "max_iter", 1, "threshold-alternating: ")
+
+    def segment(self, X, y, n_regions, structure, rng, columns=None) -> SegmentationResult:
+        """The threshold split's labels, alternated to a local minimum; no fixed partition."""
+        self.check_params()
         try:
             split = ThresholdSegmenter(column=self.column, n_grid=self.n_grid, min_share=self.min_share).segment(
                 X, y, n_regions, structure, rng, columns=columns)

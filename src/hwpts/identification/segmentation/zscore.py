@@ -30,10 +30,17 @@ class ZScoreSegmenter(Segmenter):
     def __init__(self, *, threshold: float = 0.0):
         self.threshold = threshold
 
+    def check_params(self) -> None:
+        """``threshold`` (see :meth:`Segmenter.check_params`)."""
+        from hwpts.identification.settings import is_number
+
+        if not is_number(self.threshold, -np.inf):
+            raise ParameterError(f"zscore: threshold must be a finite number (a z-score of the output), "
+                                 f"got {self.threshold!r}")
+
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
         """Two regions: rows whose output's z-score is at least ``threshold``, and the rest."""
-        if not np.isfinite(self.threshold):
-            raise ParameterError(f"zscore threshold must be finite, got {self.threshold!r}")
+        self.check_params()
         sd = float(np.std(y))
         if sd == 0:
             raise IdentificationError("zscore segmentation needs a non-constant output")

@@ -342,6 +342,9 @@ class PWARXSearch(BaseEstimator):
         of ``methods``, at that count only (not the shared modes of step 3, whose ``K`` modes make
         ``K`` or more regions), and the choice is made among the candidates with that count
         (``1``: among the single ARX models, with the power terms). ``max_regions`` is then not used.
+        It is the count asked of the segmentation: a learned partition may leave a region without
+        training rows, which is then dropped (a ``RegionWarning``), so ``best_estimator_.n_regions_``
+        can be lower than ``best_params_["n_regions"]`` (``n_regions_fitted`` in ``cv_results_``).
     patience : int
         Region counts in a row without a better score before the growth stops.
     tolerance : float
@@ -601,6 +604,7 @@ class PWARXSearch(BaseEstimator):
         base = self._base()
         base._check_settings()  # a bad estimator setting is said as PWARX says it, not as every candidate failing
         u, yy, names, oname = base._signals(X, y, input_names, output_name)
+        self._check_orders(base, u.shape[1])
         if np.ptp(yy) == 0:
             raise DataError(f"output {oname or 'y'!r} is constant in the training data ({yy[0]:.6g}); "
                             f"there is nothing to identify")
@@ -641,6 +645,8 @@ class PWARXSearch(BaseEstimator):
                     if unknown:
                         raise ParameterError(f"PWARXSearch: param_grid names {unknown}, which the estimator does not "
                                              f"have; valid are {sorted(valid)}")
+                    for candidate in candidates:  # a bad value is said before any fit, not as a failed candidate
+                        self._check_candidate(base, candidate, u.shape[1])
                     table = self._run(base, candidates, u, yy, splits, "grid", bar)
                 else:
                     self._check_kept_partition(base)
@@ -654,6 +660,39 @@ class PWARXSearch(BaseEstimator):
         self.best_estimator_.sample_time_ = None if sample_time is None else float(sample_time)
         self.best_estimator_.units_ = {str(k): str(v) for k, v in dict(units or {}).items()}
         return self
+
+    @staticmethod
+    def _check_orders(estimator, n_inputs: int, owner: str = "PWARXSearch: ") -> None:
+        """The orders ``estimator`` is given (those not ``None``) are what a model takes."""
+        from hwpts.identification.regressors import as_order_tuple
+        from hwpts.identification.settings import is_count
+
+        try:
+            if estimator.output_order is not None and not is_count(estimator.output_order, 0):
+                raise ParameterError(f"na (output order) must be an int >= 0, got {estimator.output_order!r}")
+            for name, label in (("input_order", "nb (input order)"), ("input_delay", "nk (input delay)")):
+                if getattr(estimator, name) is not None:
+                    as_order_tuple(getattr(estimator, name), n_inputs, label, 0)
+        except ParameterError as error:
+            raise ParameterError(f"{owner}{error}") from None
+
+    def _check_candidate(self, base, params: dict, n_inputs: int) -> None:
+        """One line naming a ``param_grid`` candidate's bad value before any fit (scikit-learn's
+        grid search would fit it and record the failure; a typo in a grid is the user's to fix)."""
+        from hwpts.identification.settings import is_count
+
+        owner = f"PWARXSearch: param_grid candidate {params}: "
+        try:
+            estimator = clone(base).set_params(**params)
+            estimator._check_settings()
+        except (ParameterError, TypeError, ValueError) as error:
+            raise ParameterError(f"{owner}{error}") from None
+        if not is_count(estimator.n_regions, 1):
+            raise ParameterError(f"{owner}n_regions must be an int >= 1, got {estimator.n_regions!r}")
+        if isinstance(estimator.segmentation, str) and estimator.segmentation == "auto":
+            raise ParameterError(f"{owner}segmentation 'auto' is the search itself; give the methods to try, "
+                                 f"e.g. 'segmentation': ['threshold', 'alternating']")
+        self._check_orders(estimator, n_inputs, owner)
 
     @staticmethod
     def _orders_of(base, orders) -> tuple:
