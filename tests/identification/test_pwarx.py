@@ -395,8 +395,10 @@ def test_complex_and_sparse_input_are_refused():
     model = PWARX(1, 1, 1, n_regions=1, segmentation="average").fit(d.inputs, d.output)
     with pytest.raises(DataError, match="inputs is complex"):
         model.predict(d.inputs * (1 + 0j), d.output)
-    with pytest.raises(DataError, match="must hold numbers"):
+    with pytest.raises(DataError, match="inputs holds text"):
         model.predict(np.array([["a", "b"]] * 300), d.output)
+    with pytest.raises(DataError, match="must hold numbers"):
+        model.predict(np.array([[object(), 1.0]] * 300, dtype=object), d.output)
 
 
 def test_a_dataset_at_another_sample_time_is_refused():

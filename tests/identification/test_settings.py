@@ -183,6 +183,26 @@ def test_simulate_before_fit_and_short_initial_outputs():
     with pytest.raises(DataError, match="need 2 initial outputs, got 1"):
         model.simulate(u[:2], initial_output=[0.1])  # not broadcast into both lags
     np.testing.assert_array_equal(model.simulate(u[:2], initial_output=[0.1, 0.2]).output, [0.1, 0.2])
+    np.testing.assert_array_equal(model.simulate(u[:2], initial_output=[[0.1, 0.2]]).output, [0.1, 0.2])
+
+
+def test_what_would_be_ignored_is_refused():
+    """Arguments that were read past without a word: a measured output beside initial_output (which
+    one sets the start?), a matrix of initial outputs flattened, names beside an IODataset's own,
+    text read as numbers (scikit-learn refuses it too)."""
+    from hwpts.dataset import IODataset
+
+    u, y = two_modes()
+    model = PWARX(2, 1, 1, segmentation="threshold", n_regions=2, random_state=0).fit(u, y)
+    with pytest.raises(ParameterError, match="from initial_output or from the measured output"):
+        model.simulate(u, y, initial_output=y[:2])
+    with pytest.raises(DataError, match=r"initial_output must be a vector of the first outputs, got shape \(2, 2\)"):
+        model.simulate(u, initial_output=[[1.0, 2.0], [3.0, 4.0]])
+    data = IODataset(np.arange(y.size, dtype=float), u.reshape(-1, 1), y, ("u",), "y")
+    with pytest.raises(ParameterError, match="input_names and output_name are the IODataset's own"):
+        PWARX(1, 1, 1).fit(data, input_names=["zz"])
+    with pytest.raises(DataError, match="inputs holds text"):
+        PWARX(1, 1, 1).fit(u.astype(str), y)
 
 
 def test_a_score_against_a_measured_nan_is_an_error():

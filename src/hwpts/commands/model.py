@@ -715,7 +715,7 @@ def cmd_identify(args) -> int:
             raise DataError(f"standard output: cannot write the summary ({error.strerror or error}); "
                             f"{args.out} was not written") from None
 
-    save_model(model, args.out, before_commit=report)
+    save_model(model, args.out, before_commit=report, argument="--out")
     if closed:
         raise closed[0]  # handled as every command's closed pipe
     return 0

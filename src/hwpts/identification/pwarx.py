@@ -157,6 +157,11 @@ class PWARX(BaseEstimator):
         the command line).
     units_ : dict
         Units of the signals by name, when known.
+    condition_ : ndarray, shape (n_regions,)
+        Condition number of each region's (column-scaled) least-squares matrix (``nan`` where not
+        fitted); a :class:`RegionWarning` names a region beyond 1e10.
+    n_features_in_ : int
+        Number of inputs (scikit-learn's name).
 
     Examples
     --------
@@ -206,6 +211,10 @@ class PWARX(BaseEstimator):
         if isinstance(X, IODataset):
             if y is not None:
                 raise ParameterError("pass either an IODataset or (inputs, output), not both")
+            if names is not None or output_name is not None:  # the dataset names its own signals
+                raise ParameterError(f"input_names and output_name are the IODataset's own "
+                                     f"({list(X.input_names)}, {X.output_name!r}); build the dataset with "
+                                     f"the names instead of passing them to fit")
             return X.inputs, X.output, X.input_names, X.output_name
         if y is None:
             raise ParameterError("fit needs the measured output y (or an IODataset)")
@@ -304,6 +313,8 @@ class PWARX(BaseEstimator):
 
         ``X`` may be a pandas DataFrame: its column names become the input names, and later
         predictions select the columns by name (in any order). ``y`` may have shape (n, 1).
+        ``input_names`` (one per input) and ``output_name`` name plain arrays' signals (default
+        ``u1, u2, ...`` and ``y``, or a named Series' name); an IODataset names its own.
         ``breaks``: sample positions where the record restarts (several experiments joined, or the
         two sides of a held-out block); regressor rows whose lags span a break are dropped.
         ``sample_time``: the sample period [s] of the data (taken from an IODataset's time when not
@@ -527,8 +538,14 @@ class PWARX(BaseEstimator):
         check_is_fitted(self, "theta_")
         m = self.structure_.max_lag
         if initial_output is not None:
+            if y is not None or (isinstance(X, IODataset)):
+                raise ParameterError("simulate takes the initial outputs from initial_output or from the measured "
+                                     "output (y, or an IODataset's), not both")
             u, _ = self._check_inputs(X, None, need_y=False)
-            y0 = np.asarray(initial_output, dtype=float).ravel()
+            y0 = np.asarray(initial_output, dtype=float)
+            if y0.ndim > 1 and sum(d > 1 for d in y0.shape) > 1:
+                raise DataError(f"initial_output must be a vector of the first outputs, got shape {y0.shape}")
+            y0 = y0.ravel()
             if not np.all(np.isfinite(y0)):
                 raise DataError("initial_output has a non-finite value")
         else:

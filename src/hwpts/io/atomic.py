@@ -164,11 +164,12 @@ def atomic_path(path: str | os.PathLike, suffix: str | None = None, argument: st
         raise
 
 
-def write_text_atomic(path: str | os.PathLike, text: str, before_commit=None) -> None:
+def write_text_atomic(path: str | os.PathLike, text: str, before_commit=None, argument: str = "--out") -> None:
     """Write ``text`` to ``path`` atomically (UTF-8). ``before_commit()``, when given, runs once the
     text is written and before the rename: if it fails (or the run is interrupted in it) ``path``
-    is left as it was (what a command prints about the file belongs there)."""
-    with atomic_path(path) as tmp:
+    is left as it was (what a command prints about the file belongs there). ``argument`` names
+    the path in an error."""
+    with atomic_path(path, argument=argument) as tmp:
         tmp.write_text(text, encoding="utf-8")
         if before_commit is not None:
             before_commit()

@@ -149,9 +149,11 @@ def dumps_model(model) -> str:
     return json.dumps(model_to_dict(model), indent=1, allow_nan=False) + "\n"
 
 
-def save_model(model, path: str | os.PathLike, before_commit=None) -> None:
+def save_model(model, path: str | os.PathLike, before_commit=None, argument: str = "path") -> None:
     """Write the model file atomically (temporary file, then rename); ``before_commit()`` runs
-    between the two (:func:`hwpts.io.atomic.write_text_atomic`).
+    between the two (:func:`hwpts.io.atomic.write_text_atomic`); ``argument`` names ``path`` in an
+    error (the command line's ``--out``). A missing parent folder is created; an existing folder,
+    a symbolic link or a device at ``path`` is refused.
 
     >>> import tempfile, pathlib, numpy as np
     >>> from hwpts.identification import PWARX
@@ -164,7 +166,7 @@ def save_model(model, path: str | os.PathLike, before_commit=None) -> None:
     """
     from hwpts.io.atomic import write_text_atomic
 
-    write_text_atomic(path, dumps_model(model), before_commit)
+    write_text_atomic(path, dumps_model(model), before_commit, argument)
 
 
 def _reject_constant(token):

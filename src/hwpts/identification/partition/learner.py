@@ -17,7 +17,9 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
+from sklearn.base import BaseEstimator
 
+from hwpts.errors import DataError, ParameterError
 from hwpts.identification.partition.polyhedra import fit_linear_partition
 
 __all__ = ["PartitionLearner", "drop_empty_regions", "noise_variance", "confident_rows", "TRIM"]
@@ -62,7 +64,7 @@ def confident_rows(cost, labels, margin: float, n_labels: int, min_rows: int):
     return confident
 
 
-class PartitionLearner:
+class PartitionLearner(BaseEstimator):
     """Region classifier and boundary refinement (module doc).
 
     Parameters
@@ -104,6 +106,50 @@ class PartitionLearner:
         self.separable_C = separable_C
         self.random_state = random_state
 
+    def check_params(self) -> None:
+        """One line naming a setting that is not what it takes (before any fit)."""
+        from hwpts.identification.settings import check_bool, check_count, check_number
+
+        owner = "PartitionLearner: "
+        check_count(self.refinement_rounds, "refinement_rounds", 0, owner)
+        check_number(self.C, "C", strict=True, owner=owner)
+        check_number(self.ridge, "ridge", owner=owner)
+        check_bool(self.sparse, "sparse", owner)
+        check_number(self.confidence_margin, "confidence_margin", owner=owner)
+        check_count(self.classifier_rows, "classifier_rows", 100, owner)
+        check_number(self.sparse_tol, "sparse_tol", owner=owner)
+        check_number(self.trim, "trim", strict=True, owner=owner)
+        if self.separable_C is not None:
+            check_number(self.separable_C, "separable_C", strict=True, owner=owner)
+        try:
+            np.random.default_rng(self.random_state)
+        except (TypeError, ValueError):
+            raise ParameterError(f"{owner}random_state must be None, an int >= 0 or a numpy Generator, "
+                                 f"got {self.random_state!r}") from None
+
+    @staticmethod
+    def _check_rows(X, y, labels, s):
+        """``(X, y, labels)`` as arrays: X (n, p) finite, y (n,) finite, labels whole numbers in
+        ``0 .. s-1`` (a label of -1 or 1.5 is no region)."""
+        from hwpts.identification.settings import is_count
+
+        if not is_count(s, 1):
+            raise ParameterError(f"PartitionLearner: s (the number of regions) must be an int >= 1, got {s!r}")
+        X = np.asarray(X, dtype=float)
+        y = np.asarray(y, dtype=float)
+        raw = np.asarray(labels)
+        if X.ndim != 2 or y.ndim != 1 or raw.ndim != 1 or not X.shape[0] == y.shape[0] == raw.shape[0]:
+            raise DataError(f"PartitionLearner: expected X of shape (n, p), y and labels of shape (n,), got "
+                            f"{X.shape}, {y.shape} and {raw.shape}")
+        if X.shape[0] == 0 or not (np.all(np.isfinite(X)) and np.all(np.isfinite(y))):
+            raise DataError("PartitionLearner: X and y must hold at least one row of finite numbers")
+        if raw.dtype.kind not in "iu" and not (raw.dtype.kind in "bf" and np.array_equal(raw, np.round(raw))):
+            raise DataError(f"PartitionLearner: labels must be whole numbers 0 .. {s - 1}, got values of type {raw.dtype}")
+        labels = raw.astype(np.int64)
+        if labels.min() < 0 or labels.max() >= s:
+            raise DataError(f"PartitionLearner: labels must lie in 0 .. {s - 1}, got {labels.min()} .. {labels.max()}")
+        return X, y, labels
+
     def learn(self, X, y, labels, s, constant=True, columns=None, init=None):
         """``(labels, partition, sparse_columns)`` for the rows ``X`` labelled ``labels``
         (``0 .. s-1``); ``columns``: regressor columns the classifier may use (default all);
@@ -111,7 +157,8 @@ class PartitionLearner:
         ``sparse_columns`` is None unless the sparse step dropped some."""
         from hwpts.identification.local_models import fit_local_models
 
-        labels = np.asarray(labels, dtype=np.int64)
+        self.check_params()
+        X, y, labels = self._check_rows(X, y, labels, s)
         rng = np.random.default_rng(self.random_state)
         # the first classifier on at most classifier_rows rows drawn at random (every region kept):
         # far more rows hardly move a logistic boundary and cost a Newton step each

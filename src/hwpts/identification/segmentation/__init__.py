@@ -44,7 +44,10 @@ SEGMENTATION_METHODS: dict[str, type[Segmenter]] = {
     "switched": SwitchedSegmenter,
 }
 
-__all__ = ["SEGMENTATION_METHODS", "make_segmenter", "Segmenter", "SegmentationResult", "clear_caches"]
+__all__ = ["SEGMENTATION_METHODS", "make_segmenter", "Segmenter", "SegmentationResult", "clear_caches",
+           "AlternatingSegmenter", "AverageSegmenter", "ClusteringSegmenter", "HyperplaneSegmenter",
+           "KMeansSegmenter", "SwitchedSegmenter", "ThresholdAlternatingSegmenter", "ThresholdSegmenter",
+           "ZScoreSegmenter"]
 
 
 def make_segmenter(name: str, **params) -> Segmenter:

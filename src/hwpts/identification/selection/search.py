@@ -400,10 +400,12 @@ class PWARXSearch(BaseEstimator):
         ``switched_fits_percent`` by number of modes, the ``best_one_step`` held-out fit it was
         compared with); ``None`` when the stage was not reached.
     cv_results_ : list of dict
-        One row per candidate, in the order tried: ``params``, ``split_fits_percent``,
-        ``mean_fit_percent`` (``None`` when diverged or failed), ``diverged``, ``error``,
-        ``n_regions_fitted``, ``fit_time_s``, ``stage``, ``rank`` (1 = best; diverged/failed last),
-        ``chosen``.
+        One row per candidate, in the order tried: ``params``, ``split_fits_percent`` and
+        ``split_one_step_fits_percent`` (per held-out block, as far as it got),
+        ``mean_fit_percent`` and ``mean_one_step_fit_percent`` (``None`` when diverged, failed or
+        pruned), ``diverged``, ``pruned`` (its remaining blocks skipped: behind the leader on the
+        same blocks), ``error``, ``n_regions_fitted``, ``fit_time_s``, ``stage``, ``rank`` (1 =
+        best; diverged/failed/pruned last), and ``chosen`` (``True``) on the chosen row.
     n_splits_ : int
 
     Examples
