@@ -182,6 +182,7 @@ def test_a_signal_inside_the_folder_swap_lets_the_swap_complete(tmp_path, monkey
     out = tmp_path / "results"
     out.mkdir()
     (out / "summary.json").write_text('{"schema": "test/1", "run": 1}')
+    (out / ".hwpts-files").write_text('["summary.json"]')  # the earlier run's list of its files
     real_replace = os.replace
     calls = []
 

@@ -120,6 +120,7 @@ def test_failed_stage_keeps_the_earlier_run(tmp_path, capsys, monkeypatch):
     out.mkdir()
     (out / "summary.json").write_text(json.dumps({"schema": "hwpts.reproduce/1", "seed": 7}))
     (out / "stale.txt").write_text("from an earlier run")
+    (out / ".hwpts-files").write_text(json.dumps(["summary.json", "stale.txt"]))
 
     def broken(_sweeps):
         raise IdentificationError("no fracture found (test)")
@@ -129,7 +130,7 @@ def test_failed_stage_keeps_the_earlier_run(tmp_path, capsys, monkeypatch):
     err = capsys.readouterr().err.strip().splitlines()
     assert status == 2 and len(err) == 1
     assert "stage 'segmentation' failed" in err[0] and "Traceback" not in err[0]
-    assert sorted(p.name for p in out.iterdir()) == ["stale.txt", "summary.json"]
+    assert sorted(p.name for p in out.iterdir()) == [".hwpts-files", "stale.txt", "summary.json"]
     assert json.loads((out / "summary.json").read_text())["seed"] == 7
     assert [p.name for p in tmp_path.iterdir()] == ["results"]  # the staging folder is gone
 
@@ -159,4 +160,11 @@ def test_a_file_the_earlier_run_did_not_write_is_not_deleted(quick_run, tmp_path
     capsys.readouterr()
     assert main(["reproduce", "--quick", "--out", str(out)]) == 2
     assert "also holds files it did not write (notes.txt)" in capsys.readouterr().err
+    assert (out / "notes.txt").read_text() == "mine"
+    # a copy made with `cp -r run/* copy/` leaves the hidden list of files behind: nothing tells the
+    # run's files from the user's, and the notes were deleted with the folder
+    (out / ".hwpts-files").unlink()
+    assert main(["reproduce", "--quick", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "an earlier run's folder without its list of files (.hwpts-files)" in err[0]
     assert (out / "notes.txt").read_text() == "mine"

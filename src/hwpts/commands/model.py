@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import sys
 import time
 import warnings
@@ -64,6 +65,10 @@ def _rows(text: str | None):
 
 # conventional names of a time column in seconds, tried in this order when --time is not given
 TIME_COLUMNS = ("time_s", "t_s", "time", "t")
+# other names taken as the time column (in the file's order, after those): any case of time,
+# timestamp, time_s, t_s, and time or t with a unit suffix (time_ms, t_us, Time_min, ...); a lone
+# upper-case T is left alone (a temperature as often as a time)
+TIME_PATTERN = re.compile(r"(time|timestamp|time_s|t_s|(time|t)_(ms|us|ns|min|h))", re.IGNORECASE)
 NO_TIME = "none"  # --time none: no time column, the sample index is the time axis
 # a .mat file's scalar variable that gives the sample period in seconds (as MATLAB's iddata Ts),
 # tried in this order when the file has no time column and --time is not given
@@ -109,7 +114,10 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
     elif time_name is not None:
         candidates = [time_name]
     else:
-        candidates = [c for c in TIME_COLUMNS if c not in signals]
+        from hwpts.io.datasets import column_names
+
+        others = [c for c in column_names(path) if TIME_PATTERN.fullmatch(c) and c not in TIME_COLUMNS]
+        candidates = [c for c in (*TIME_COLUMNS, *others) if c not in signals]
     try:
         columns = read_table(path, [*signals, *candidates])
     except DataError:
@@ -931,7 +939,8 @@ def cmd_predict(args) -> int:
 def _common_data_args(parser):
     parser.add_argument("--time", metavar="COL", default=None,
                         help="time column, in s unless its name ends in _ms, _us, _ns, _min or _h (default: the "
-                             "first of time_s, t_s, time, t present, else the sample index; 'none': the sample "
+                             "first of time_s, t_s, time, t present, then Time, timestamp, time_ms, ... in any "
+                             "case, else the sample index, or a .mat file's scalar Ts; 'none': the sample "
                              "index); its step is the sample time")
     parser.add_argument("--rows", metavar="START:STOP", default=None,
                         help="use only these rows (Python slice: 0:5000; write --rows=-1001: for a negative start)")

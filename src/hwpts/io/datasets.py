@@ -139,6 +139,34 @@ def _has_hex(data: bytes, delimiter: str, names: list[str]) -> bool:
     return any(pc.any(pc.match_substring(text.column(n), "x", ignore_case=True)).as_py() for n in names)
 
 
+def column_names(path: str | os.PathLike) -> list[str]:
+    """The names of a table's columns without reading its data where the format allows (a CSV's
+    header row, a Parquet schema; a .mat file is read); ``[]`` when they cannot be read (the
+    reader says why)."""
+    import csv
+    import io
+
+    p = Path(path)
+    suffix = p.suffix.lower()
+    try:
+        if suffix == ".csv":
+            with p.open("rb") as f:
+                head = f.read(65536)
+            text = head.decode("utf-8-sig", errors="replace")
+            first = next((line for line in text.splitlines() if line.strip()), "")
+            row = next(csv.reader(io.StringIO(first), delimiter=_sniff(p, head)), [])
+            return [name.strip() for name in row if name.strip()]
+        if suffix == ".parquet":
+            import pyarrow.parquet as pq
+
+            return list(pq.read_schema(p).names)
+        if suffix == ".mat":
+            return list(_read_mat(p))
+    except Exception:  # noqa: BLE001 - an unreadable file is said by the reader
+        return []
+    return []
+
+
 def temporal_columns(path: str | os.PathLike) -> set[str]:
     """The columns of a Parquet file typed as time stamps, durations, dates or times of day (read in
     seconds already, whatever their names say); none for another format."""

@@ -40,10 +40,14 @@ def check_replaceable(path: str | os.PathLike, schema: str, marker: str = "summa
             f"--out {str(out)!r}: the folder exists and holds files that are not an earlier hwpts run "
             f"(no {marker} with schema {schema!r}); choose another folder or empty it"
         )
-    try:  # the files the earlier run wrote (runs before the list existed: not checked)
+    try:  # the files the earlier run wrote
         written = set(json.loads((out / MANIFEST).read_text(encoding="utf-8")))
     except (OSError, ValueError, TypeError):
-        return
+        # no list (a copy made with `cp -r run/* copy/` leaves the hidden file behind, or a run of
+        # an old version): nothing tells the run's files from the user's, so nothing is replaced
+        raise DataError(f"--out {str(out)!r}: an earlier run's folder without its list of files ({MANIFEST}), so "
+                        f"its files cannot be told from others; a run replaces the folder as a whole: "
+                        f"choose another folder, or delete this one") from None
     extra = sorted(name for name in _files(out) if name not in written and name != MANIFEST)
     if extra:
         shown = ", ".join(extra[:3]) + (f" and {len(extra) - 3} more" if len(extra) > 3 else "")
