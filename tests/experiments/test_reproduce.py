@@ -168,3 +168,25 @@ def test_a_file_the_earlier_run_did_not_write_is_not_deleted(quick_run, tmp_path
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "an earlier run's folder without its list of files (.hwpts-files)" in err[0]
     assert (out / "notes.txt").read_text() == "mine"
+
+
+def test_the_models_know_their_signals_units(quick_run, tmp_path, capsys):
+    """The models of `reproduce` carried no units, so their guard against a column in other units
+    (what `identify`'s models refuse) never ran: a speed in rad/s scored -1389 % without a reason."""
+    import csv
+
+    for path in sorted((quick_run / "models").glob("*.json")):
+        units = json.loads(path.read_text())["signals"]["units"]
+        assert units["motor_a_speed_rpm"] == "r/min" and units["pump_speed_rpm"] == "r/min", path.name
+    with open(quick_run / "data" / "case2.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    data = tmp_path / "rad.csv"
+    with open(data, "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=[*rows[0], "motor_a_speed_rad_s"])
+        writer.writeheader()
+        for row in rows:
+            writer.writerow({**row, "motor_a_speed_rad_s": float(row["motor_a_speed_rpm"]) * np.pi / 30})
+    capsys.readouterr()
+    assert main(["validate", str(quick_run / "models" / "best.json"), str(data), "--input", "valve_voltage_play_v",
+                 "--input", "pump_speed_rpm", "--output", "motor_a_speed_rad_s"]) == 2
+    assert "is in r/min, and this column's name says rad/s" in capsys.readouterr().err

@@ -113,6 +113,7 @@ def identify_model_bank(seed: int, quick: bool = False):
     from hwpts.experiments.sweeps import estimate_hysteresis, find_fracture, record_sweeps
     from hwpts.identification import PWARX
     from hwpts.plant import PlantParameters, TestBed, identification_excitation
+    from hwpts.units import units_from_names
 
     config = paper.ReproduceConfig.quick_run(seed) if quick else paper.ReproduceConfig.full(seed)
     sweeps = record_sweeps(PlantParameters.paper(), progress=False)
@@ -125,7 +126,8 @@ def identify_model_bank(seed: int, quick: bool = False):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         model = PWARX(paper.NA, paper.NB, paper.NK, segmentation="hyperplane",
-                      hyperplanes=paper.paper_hyperplanes(fracture, paper.COMPENSATED_INPUT)).fit(data)
+                      hyperplanes=paper.paper_hyperplanes(fracture, paper.COMPENSATED_INPUT)).fit(
+                          data, units=units_from_names([*data.input_names, data.output_name]))
     return model, float(r_hat), config.sample_time_s
 
 

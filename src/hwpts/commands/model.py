@@ -12,6 +12,7 @@ import numpy as np
 from hwpts.commands._args import json_text
 from hwpts.errors import DataError, ParameterError, SimulationError
 from hwpts.text import plain_int
+from hwpts.units import unit_from_name
 
 
 def _int_list(text: str, name: str):
@@ -260,9 +261,6 @@ def _check_sample_time(model, data, dt, path, resample: bool):
 
 
 # units recognised from a column name's suffix (the plant's and the paper's naming: speed_rpm, ...)
-UNIT_SUFFIXES = {"_rpm": "r/min", "_v": "V", "_bar": "bar", "_s": "s", "_nm": "N m", "_mm": "mm",
-                 "_m": "m", "_hz": "Hz", "_w": "W", "_kw": "kW", "_pct": "%", "_lpm": "L/min", "_deg": "deg",
-                 "_rad": "rad", "_ms": "ms", "_pa": "Pa"}
 # a time column's unit by its suffix, in seconds (a name without one is in seconds)
 TIME_SUFFIXES = {"_ms": 1e-3, "_us": 1e-6, "_ns": 1e-9, "_min": 60.0, "_h": 3600.0}
 
@@ -273,27 +271,12 @@ def time_seconds(name: str) -> float:
     return next((v for k, v in TIME_SUFFIXES.items() if low.endswith(k)), 1.0)
 
 
-def _unit_of(name: str) -> str | None:
-    """A signal's unit from its name's suffix: ``speed_rpm`` r/min; ``v_mm_s`` mm/s (a rate:
-    another unit before ``_s``; it was labelled s)."""
-    low = str(name).lower()
-    for suffix, unit in UNIT_SUFFIXES.items():
-        if low.endswith(suffix):
-            if suffix == "_s":
-                before = low[:-2]
-                inner = next((u for k, u in UNIT_SUFFIXES.items() if k != "_s" and before.endswith(k)), None)
-                if inner is not None:
-                    return f"{inner}/s"
-            return unit
-    return None
-
-
 def _units(names, given) -> dict:
     """Units of the named signals: ``--unit NAME=UNIT`` (once a signal, and agreeing with a unit
     its name's suffix says), else from the name's suffix."""
     units, told = {}, {}
     for name in names:
-        unit = _unit_of(name)
+        unit = unit_from_name(name)
         if unit is not None:
             units[name] = unit
     for text in given or ():
@@ -306,7 +289,7 @@ def _units(names, given) -> dict:
         if name in told:
             raise ParameterError(f"--unit {text!r}: {name!r} was given the unit {told[name]!r} already; "
                                  f"expected one --unit per signal")
-        said = _unit_of(name)
+        said = unit_from_name(name)
         known = {*UNIT_SUFFIXES.values(), *(f"{u}/s" for u in UNIT_SUFFIXES.values())}
         if said is not None and unit in known and said != unit:  # as validate refuses a column named in another
             # unit; free text ("rpm") is not compared
@@ -817,8 +800,8 @@ def _check_mapped_units(model, inputs, output) -> None:
     pairs.append(("--output", st.output_name, output))
     for flag, name, column in pairs:
         # only a unit the model took from its signal's own name (--unit text is free: 'rpm', 'v')
-        known, says = units.get(name), _unit_of(column)
-        if column != name and known and says and known == _unit_of(name) and known != says:
+        known, says = units.get(name), unit_from_name(column)
+        if column != name and known and says and known == unit_from_name(name) and known != says:
             raise DataError(f"{flag} {column!r}: the model's {name!r} is in {known}, and this column's name says "
                             f"{says}; convert the data to {known} (or map a column in {known})")
 

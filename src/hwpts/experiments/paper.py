@@ -42,6 +42,7 @@ from hwpts.identification import PWARX, Hyperplane, fit_percent
 from hwpts.identification.segmentation.hyperplane import fracture_hyperplane
 from hwpts.plant import CASE_NAMES, PlantParameters, SweepResult, TestBed, identification_excitation, play_operator
 from hwpts.plant import validation_case as _case_profile
+from hwpts.units import units_from_names
 
 PAPER_REPORTED_FIT = {"case2": 92, "case3": 93, "case4": 91}
 """Fit % the paper reports for its cases 2-4 (section V.D; no number is printed for case 1)."""
@@ -269,6 +270,9 @@ def run(config: ReproduceConfig, progress: Callable[[str], None] | None = None) 
     train = {True: compensate(identification, r_hat), False: identification}
     valid = {name: {True: compensate(ds, r_hat), False: ds} for name, ds in cases.items()}
 
+    # the signals' units from their names (motor_a_speed_rpm: r/min), kept in every model as
+    # `hwpts identify` keeps them, so that data whose columns say other units are refused
+    units = {comp: units_from_names([*ds.input_names, ds.output_name]) for comp, ds in train.items()}
     try:
         t0 = stage("identification")
         methods = {}
@@ -276,14 +280,14 @@ def run(config: ReproduceConfig, progress: Callable[[str], None] | None = None) 
             t1 = time.perf_counter()
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                model = factory().fit(train[comp])
+                model = factory().fit(train[comp], units=units[comp])
             methods[name] = MethodResult(name, description, model, comp, fit_time_s=time.perf_counter() - t1)
         # best: choose on a held-out tail of the identification data only, then refit on all of it
         t1 = time.perf_counter()
         labels, search = _best_search(fracture, config.polish_candidates)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            search.fit(train[True])
+            search.fit(train[True], units=units[True])
         best = search.best_estimator_
         selection = []
         for label, row in zip(labels, search.cv_results_):
