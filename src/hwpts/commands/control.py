@@ -157,8 +157,12 @@ def _model_bank(args):
                             f"control loop's {SAMPLE_TIME_S:g} s (up to 10 s); identify it from data sampled at "
                             f"a multiple of 10 ms")
         return model, model_to_dict(model), dt, half_width, f"file {args.model}"
-    print("identifying the model bank as 'hwpts reproduce' does (method 'paper') ...", file=sys.stderr)
-    model, r_hat, sample_time = identify_model_bank(args.seed)
+    from tqdm import tqdm
+
+    # a status line on a terminal, cleared when done (an error after it stays the one line said)
+    with tqdm(total=1, desc="identifying the model bank as 'hwpts reproduce' does (method 'paper')",
+              bar_format="{desc} ...", disable=not sys.stderr.isatty(), leave=False):
+        model, r_hat, sample_time = identify_model_bank(args.seed)
     half_width = r_hat if args.hysteresis_width is None else args.hysteresis_width
     return model, model_to_dict(model), sample_time, half_width, \
         f"identified on the test bed (method 'paper', seed {args.seed})"
@@ -247,6 +251,7 @@ def run_command(args) -> int:
     from tqdm import tqdm
 
     from hwpts.control.controllers import parse_names
+    from hwpts.control.controllers.pi import UnreachableSetpoint
     from hwpts.control.run import SCHEMA, check_setpoint, run_scenario
     from hwpts.errors import ParameterError
     from hwpts.io.atomic import write_bytes_atomic, write_text_atomic
@@ -270,8 +275,11 @@ def run_command(args) -> int:
             bar.n = int(1000 * fraction)
             bar.refresh()
 
-        summary, runs, scenario = run_scenario(bank, half_width, args.scenario, names, args.seed, args.setpoint,
-                                               args.duration, source, progress)
+        try:
+            summary, runs, scenario = run_scenario(bank, half_width, args.scenario, names, args.seed,
+                                                   args.setpoint, args.duration, source, progress)
+        except UnreachableSetpoint as error:
+            raise ParameterError(f"--setpoint {args.setpoint:g}: {error}") from None
     with staged_folder(args.out, SCHEMA) as stage:
         for name, result in runs.items():
             write_csv(stage / "data" / f"{name}.csv", result.columns)

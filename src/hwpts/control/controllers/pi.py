@@ -17,12 +17,16 @@ SPEED_FILTER_S = 0.02
 """Low-pass on the measured speed against sensor noise [s]."""
 
 
+class UnreachableSetpoint(DataError):
+    """The model bank has no steady state at the set-point (the command line names ``--setpoint``)."""
+
+
 def nominal_design(bank: ModelBank, setpoint: float, pump: float):
     """(region, feedforward voltage) of the model's steady state at the nominal operating point."""
     u, region = bank.steady_valve(setpoint, pump)
     if region is None:
-        raise DataError(f"the model has no steady state at {setpoint:g} r/min with the pump at {pump:g} r/min; "
-                        "choose a reachable set-point")
+        raise UnreachableSetpoint(f"the model has no steady state at {setpoint:g} r/min with the pump at {pump:g} "
+                                  f"r/min; choose a reachable set-point")
     return region, float(u)
 
 
