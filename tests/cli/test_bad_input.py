@@ -109,6 +109,7 @@ def workspace(tmp_path_factory):
                                                       for i in range(40)),
         "bigtime.csv": "time_s,u1,u2,y\n" + "".join(f"{i * 1e6},{i % 4},{i % 3},{i % 5}\n" for i in range(40)),
         "flat_output.csv": "u1,u2,y\n" + "".join(f"{i % 4},{i % 3},2.5\n" for i in range(40)),
+        "comment.csv": "# recorded on the rig\nu1,u2,y\n" + "".join(f"{i % 4},{i % 3},{i}\n" for i in range(40)),
     }
     for name, text in files.items():
         if text is not None:
@@ -147,6 +148,16 @@ def _snapshot(root: Path) -> dict:
 
 W = "{ws}"  # replaced by the workspace folder
 CASES = [
+    # --- found by a review (2026-11-27): a comment line above the header read as the header, region
+    # 0 said as a count problem, a grid point named instead of the typed end, an empty --out read
+    # as the current folder
+    (["identify", f"{W}/comment.csv", *FIXED, "--out", f"{W}/m.json"],
+     "line 1: expected the header row of column names, got a comment ('# recorded on the rig')"),
+    (["identify", f"{W}/data.csv", *FIT, "--na", "1", "--nb", "1", "--zero-region", "0", "--out", f"{W}/m.json"],
+     "--zero-region: expected a region number >= 1"),
+    (["plant", "sweep", "--out", f"{W}/s.csv", "--voltages", "1:30:5"], "--voltages: valve voltage must be a finite "
+                                                                          "number in 0-10 V (the test bed's range), got 30"),
+    (["reproduce", "--out", ""], "--out: expected an output folder's path, got an empty one"),
     # --- found by a review (2026-11-26): a mistyped time cell, a Python-only number, rows beyond
     # the file, hyperplanes with an empty field or column, --regions against the hyperplanes, a
     # resampled record too long for memory

@@ -12,7 +12,7 @@ import numpy as np
 from hwpts.commands._args import json_text
 from hwpts.errors import DataError, ParameterError, SimulationError
 from hwpts.text import plain_int
-from hwpts.units import unit_from_name
+from hwpts.units import UNIT_SUFFIXES, unit_from_name
 
 
 def _int_list(text: str, name: str):
@@ -620,6 +620,10 @@ def cmd_identify(args) -> int:
                             powers=given_powers)
     region_models = None
     if args.zero_region:
+        low = min(args.zero_region)
+        if low < 1:  # said before what the count needs: regions are numbered from 1 whatever it is
+            raise ParameterError(f"--zero-region: expected a region number >= 1 (regions are numbered from 1), "
+                                 f"got {low}")
         n_hyper = len(hyperplanes) + 1 if segmentation == "hyperplane" else n_regions
         if not isinstance(n_hyper, int):
             raise ParameterError("--zero-region needs a fixed number of regions (--regions S or hyperplanes)")
@@ -957,7 +961,7 @@ def register(subparsers):
     """Add the ``identify``, ``validate`` and ``predict`` sub-commands to ``subparsers``."""
     import argparse
 
-    from hwpts.commands._args import file_with_suffix, integer, non_negative_float, non_negative_int, positive_int
+    from hwpts.commands._args import file_with_suffix, integer, non_negative_int, positive_int
 
     class ModeAction(argparse.Action):
         def __call__(self, parser, namespace, values, option_string=None):

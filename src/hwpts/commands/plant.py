@@ -117,8 +117,9 @@ def sweep_command(args) -> int:
     pumps = np.linspace(*args.pump_speeds)
     from hwpts.plant.parameters import check_input_ranges
 
-    check_input_ranges(voltages, 0.0, where="--voltages: ")
-    check_input_ranges(0.0, pumps, where="--pump-speeds: ")
+    # the grid's ends, as typed (a grid point between them named a value the user never wrote)
+    check_input_ranges(np.asarray(args.voltages[:2]), 0.0, where="--voltages: ")
+    check_input_ranges(0.0, np.asarray(args.pump_speeds[:2]), where="--pump-speeds: ")
     result = sweep(PlantParameters.paper(), voltages, pumps)
     write_table(args.out, sweep_columns(result))
     gap_rpm = float(np.max(np.abs(result.up_rpm - result.down_rpm)))

@@ -25,8 +25,9 @@ from sklearn.base import BaseEstimator
 from sklearn.utils.validation import check_is_fitted
 
 from hwpts.dataset import IODataset
-from hwpts.errors import DataError, IdentificationError, ParameterError
-from hwpts.identification.local_models import MODEL_KINDS, RegionWarning, fit_local_models
+from hwpts.errors import DataError, ParameterError
+from hwpts.identification.local_models import MODEL_KINDS, fit_local_models
+from hwpts.identification.local_models import RegionWarning  # noqa: F401 - the docstrings name it
 from hwpts.identification.partition import (
     TRIM,
     PartitionLearner,

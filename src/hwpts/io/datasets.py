@@ -244,6 +244,9 @@ def _read_csv_python(p: Path, delimiter: str = ",", columns=None) -> dict[str, n
     header = [h.strip() for h in numbered[0][1]]
     while header and not header[-1]:  # trailing empty columns (a comma at the end of every row)
         header.pop()
+    if header and header[0].startswith("#") and len(numbered) > 1 and len(numbered[1][1]) != len(numbered[0][1]):
+        raise DataError(f"{str(p)!r} line {numbered[0][0]}: expected the header row of column names, got a comment "
+                        f"({header[0][:40]!r}); remove the comment lines above the header")
     if header and all(is_number(h) for h in header):
         raise DataError(f"{str(p)!r}: expected a header row of column names first (a header row such as u,y), got numbers "
                         f"({delimiter.join(header[:4])}{', ...' if len(header) > 4 else ''})")

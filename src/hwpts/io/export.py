@@ -127,7 +127,7 @@ def control_script(doc: dict, generator: str, model_name: str) -> str:
             f"               {_py_array(B)},",
             f"               {_py_array(m['C'])},",
             f"               {_py_array(D)},",
-            f"               True if SAMPLE_TIME is None else SAMPLE_TIME, inputs=INPUTS, outputs=[OUTPUT],",
+            "               True if SAMPLE_TIME is None else SAMPLE_TIME, inputs=INPUTS, outputs=[OUTPUT],",
             f"               name={'mode' + str(m['region'])!r}),",
         ]
     lines.append("]")

@@ -16,6 +16,8 @@ from hwpts.io.atomic import commit_allowed, point_of_no_return, umask_mode
 
 def check_replaceable(path: str | os.PathLike, schema: str, marker: str = "summary.json") -> None:
     """Refuse a target that exists and is not empty, unless it is an earlier run of ``schema``."""
+    if not str(path).strip():  # Path("") is the current folder
+        raise DataError("--out: expected an output folder's path, got an empty one")
     out = Path(path)
     if out.is_symlink():
         raise DataError(f"--out {str(out)!r}: is a symbolic link; hwpts never replaces a link, give the path "

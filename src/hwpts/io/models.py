@@ -179,7 +179,7 @@ def load_model(path: str | os.PathLike):
 
     p = check_input_file(path, "model ", "a .json model file")
     try:
-        text = p.read_text(encoding="utf-8")
+        text = p.read_text(encoding="utf-8-sig")  # a byte-order mark (a Windows editor's) is no content
         doc = json.loads(text, parse_constant=_reject_constant)
     except UnicodeDecodeError:
         raise DataError(f"model {str(p)!r}: not a UTF-8 JSON file") from None

@@ -133,7 +133,6 @@ class MPCController(Controller):
     def _predict(self, y_hist, u1_hist, u2_now, u_future, regions=None):
         """Free run over the horizon; returns (y, regions, regressors used)."""
         bank = self.bank
-        na, (nb1, nb2) = bank.na, bank.nb
         ys = list(y_hist[:-1])  # past outputs up to y(k-1); y(k) itself is predicted
         u1s = list(u1_hist[:-1])
         u2s = list(u2_now)
