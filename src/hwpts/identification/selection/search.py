@@ -524,8 +524,8 @@ class PWARXSearch(BaseEstimator):
             if k < 2:
                 raise ParameterError(
                     f"{n} samples are too few to choose a model: cross-validation needs at least 2 blocks of "
-                    f"{min_block} samples ({max_lag} initial conditions + {MIN_BLOCK}); give the model settings "
-                    f"(orders, segmentation, regions) instead"
+                    f"{min_block} samples ({max_lag} initial conditions + {MIN_BLOCK}); fit one model with every "
+                    f"setting given instead (PWARX; hwpts identify: --na, --nb and --segmentation with --regions)"
                 )
             if max_lag == 0:
                 # a static map (no lagged signal): the order of the rows carries nothing, and
