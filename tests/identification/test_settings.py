@@ -374,3 +374,26 @@ def test_one_stable_linear_mode_is_not_called_diverged_far_beyond_its_training_r
     assert model.score(100 * u[:, None], big) > 99.99
     switched = PWARX(1, 1, 1, segmentation="threshold", random_state=0).fit(*two_modes())
     assert np.isfinite(switched.divergence_band()[1])  # switching stable modes can still diverge
+
+
+def test_a_time_indexed_frame_gives_its_sample_time_and_data_at_another_rate_are_refused():
+    """A DataFrame indexed by time stamps kept no sample time, and a model of 100 Hz data scored
+    data at 1 kHz without a word (an IODataset's time was checked, a DataFrame's was not)."""
+    pd = pytest.importorskip("pandas")
+    u, y = two_modes()
+    index = pd.date_range("2024-01-01", periods=y.size, freq="10ms")
+    frame, output = pd.DataFrame({"u": u[:, 0]}, index=index), pd.Series(y, index=index, name="y")
+    model = PWARX(1, 1, 1, segmentation="threshold", random_state=0).fit(frame, output)
+    assert model.sample_time_ == 0.01
+    assert PWARXSearch(PWARX(1, 1, 1, random_state=0), methods="threshold").fit(frame, output).best_estimator_.sample_time_ == 0.01
+    steps = pd.timedelta_range(0, periods=y.size, freq="20ms")
+    assert PWARX(1, 1, 1, segmentation="threshold").fit(pd.DataFrame({"u": u[:, 0]}, index=steps), y).sample_time_ == 0.02
+    fast = pd.date_range("2024-01-01", periods=y.size, freq="1ms")
+    with pytest.raises(DataError, match="time index is sampled every 0.001 s, the model every 0.01 s"):
+        model.score(pd.DataFrame({"u": u[:, 0]}, index=fast), pd.Series(y, index=fast))
+    with pytest.raises(ParameterError, match="sample_time 0.5 s differs from the DataFrame's time index"):
+        PWARX(1, 1, 1).fit(frame, output, sample_time=0.5)
+    gap = index[:-1].append(pd.DatetimeIndex([index[-1] + pd.Timedelta("4s")]))
+    with pytest.raises(DataError, match="time index is not uniformly sampled"):
+        PWARX(1, 1, 1).fit(pd.DataFrame({"u": u[:, 0]}, index=gap), y)
+    assert model.score(u, y) == model.score(frame, output)  # arrays carry no rate to check

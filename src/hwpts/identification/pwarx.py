@@ -313,7 +313,9 @@ class PWARX(BaseEstimator):
         """Identify the model from inputs ``X`` (n, n_inputs) and output ``y`` (n,), or an IODataset.
 
         ``X`` may be a pandas DataFrame: its column names become the input names, and later
-        predictions select the columns by name (in any order). ``y`` may have shape (n, 1).
+        predictions select the columns by name (in any order); indexed by time stamps or
+        durations, its step is the sample time (a time index at another rate is refused later).
+        ``y`` may have shape (n, 1).
         ``input_names`` (one per input) and ``output_name`` name plain arrays' signals (default
         ``u1, u2, ...`` and ``y``, or a named Series' name); an IODataset names its own.
         ``breaks``: sample positions where the record restarts (several experiments joined, or the
@@ -322,8 +324,7 @@ class PWARX(BaseEstimator):
         given); kept in the model so that data at another rate are refused. ``units``: optional
         ``{signal name: unit}`` kept for plots and exports. Returns ``self``.
         """
-        if isinstance(X, IODataset):
-            sample_time = dataset_sample_time(X, sample_time)
+        sample_time = data_sample_time(X, sample_time)  # an IODataset's or a time-indexed DataFrame's
         check_fit_arguments(sample_time, units, output_name)
         self._check_settings()
         u, yy, names, oname = self._signals(X, y, input_names, output_name)
@@ -459,6 +460,11 @@ class PWARX(BaseEstimator):
             X, y = _select_columns(X.inputs, X.input_names, self.input_names_), X.output
         else:
             _check_index(X, y)
+            known = getattr(self, "sample_time_", None)
+            dt = frame_sample_time(X, remedy="resample the data")
+            if known is not None and dt is not None and abs(dt - known) > 0.01 * known:
+                raise DataError(f"the DataFrame's time index is sampled every {dt:.6g} s, the model every "
+                                f"{known:.6g} s: its lags would mean other delays; resample the data or refit")
             frame_names = _column_names(X)
             X = _as_array(X)
             if frame_names is not None:
@@ -657,6 +663,43 @@ class PWARX(BaseEstimator):
 
 LIBRARY_REMEDY = ("resample it, or fit the arrays with breaks at the gaps: "
                   "fit(data.inputs, data.output, breaks=[...])")
+
+
+def frame_time(X) -> np.ndarray | None:
+    """The time [s] of a pandas object indexed by time stamps or durations (a DatetimeIndex or a
+    TimedeltaIndex), else None (a numeric index may count samples as well as seconds)."""
+    index = getattr(X, "index", None)
+    if index is None or not hasattr(index, "dtype") or getattr(index.dtype, "kind", None) not in ("M", "m"):
+        return None
+    values = np.asarray(index.values)
+    if values.dtype.kind == "M":
+        values = values - values[0] if values.size else values
+    return values.astype("timedelta64[ns]").astype(np.int64) / 1e9
+
+
+def frame_sample_time(X, what: str = "the DataFrame's time index", remedy: str = "resample it") -> float | None:
+    """The sample period [s] of a pandas object indexed by time (:func:`frame_time`), else None; a
+    time index that is not uniform is refused as a dataset's time is."""
+    time = frame_time(X)
+    if time is None or time.size < 2 or np.any(np.diff(time) <= 0):  # (an unsorted index is said by the fit)
+        return None
+    return IODataset(time, np.zeros((time.size, 1)), np.zeros(time.size), ("u",), "y").uniform_sample_time(what, remedy)
+
+
+def data_sample_time(X, sample_time):
+    """The sample time [s] to keep for a fit on ``X``: an IODataset's (:func:`dataset_sample_time`)
+    or a time-indexed DataFrame's, or ``sample_time`` (refused when it contradicts the data's)."""
+    if isinstance(X, IODataset):
+        return dataset_sample_time(X, sample_time)
+    from hwpts.identification.settings import is_number
+
+    uniform = frame_sample_time(X, remedy=LIBRARY_REMEDY)
+    if uniform is None or sample_time is None:
+        return uniform if sample_time is None else sample_time
+    if is_number(sample_time, strict=True) and abs(sample_time - uniform) > 0.01 * uniform:
+        raise ParameterError(f"sample_time {sample_time!r} s differs from the DataFrame's time index, sampled every "
+                             f"{uniform:g} s; expected that or sample_time left out")
+    return sample_time
 
 
 def dataset_sample_time(data, sample_time):

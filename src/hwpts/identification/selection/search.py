@@ -593,12 +593,9 @@ class PWARXSearch(BaseEstimator):
 
         ``sample_time`` [s] and ``units`` are kept in the chosen model as :meth:`PWARX.fit` does.
         """
-        from hwpts.dataset import IODataset
+        from hwpts.identification.pwarx import data_sample_time
 
-        if isinstance(X, IODataset):
-            from hwpts.identification.pwarx import dataset_sample_time
-
-            sample_time = dataset_sample_time(X, sample_time)
+        sample_time = data_sample_time(X, sample_time)  # an IODataset's or a time-indexed DataFrame's
         from hwpts.identification.pwarx import check_fit_arguments
 
         check_fit_arguments(sample_time, units, output_name)
