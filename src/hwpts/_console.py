@@ -1,6 +1,6 @@
 """The ``hwpts`` console script's first code: signal handlers before any import that takes time.
 
-:func:`hwpts.cli.main` handles Ctrl-C and SIGTERM as an interrupt (exit status 130, one line), but
+:func:`hwpts.cli.main` handles Ctrl-C, SIGTERM and SIGHUP as an interrupt (exit status 130, one line), but
 only once the command line's modules are imported: a signal in the first ~50 ms, while Python
 imports them, ended the process with a traceback (SIGINT) or silently with -15 (SIGTERM). Here
 both raise :class:`KeyboardInterrupt` from the first line of the script on, and after the run the
@@ -15,6 +15,9 @@ import os
 import sys
 
 import _signal  # the C module: ``signal`` imports ``enum`` first, 10 ms more of the window
+
+# Ctrl-C, SIGTERM and SIGHUP (the terminal closed; POSIX only), as hwpts.cli.INTERRUPTS
+_INTERRUPTS = tuple(getattr(_signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(_signal, name))
 
 
 def _interrupt(signum, frame):
@@ -35,12 +38,12 @@ def _interrupted() -> None:
 def entry() -> None:  # pragma: no cover - the console script, exercised in subprocess tests
     """Install the handlers, import and run :func:`hwpts.cli.main`, exit with its status."""
     try:
-        for sig in (_signal.SIGINT, _signal.SIGTERM):
+        for sig in _INTERRUPTS:
             _signal.signal(sig, _interrupt)
         from hwpts.cli import finish, main
 
         status = main()  # main restores these handlers, which then leave a late signal alone (_interrupt)
-        for sig in (_signal.SIGINT, _signal.SIGTERM):
+        for sig in _INTERRUPTS:
             _signal.signal(sig, _signal.SIG_IGN)
     except KeyboardInterrupt:
         _interrupted()

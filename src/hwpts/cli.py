@@ -78,6 +78,10 @@ def _check_outputs(args) -> None:
                                  f"replaced as a whole, which would delete it; choose another output folder")
 
 
+# the signals that stop a run as Ctrl-C does (SIGHUP: the terminal closed; POSIX only)
+INTERRUPTS = tuple(getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, name))
+
+
 def _interrupt(signum, frame):  # pragma: no cover - exercised in a subprocess test
     _INTERRUPTED.set()
     if _COMMITTING.is_set() or _SETTLED.is_set():  # inside a commit, or the run is over: recorded,
@@ -102,14 +106,14 @@ def _quiet_interrupts(hook):
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit status (0 ok, 2 bad argument, input or failure).
 
-    SIGTERM is handled as Ctrl-C: the run stops, temporary files and staging folders are removed,
-    earlier outputs stay intact, exit status 130 and one line.
+    SIGTERM and SIGHUP (the terminal closed) are handled as Ctrl-C: the run stops, temporary files
+    and staging folders are removed, earlier outputs stay intact, exit status 130 and one line.
     """
     previous: dict = {}
     hook = sys.unraisablehook
     _INTERRUPTED.clear()
     if threading.current_thread() is threading.main_thread():
-        for sig in (signal.SIGINT, signal.SIGTERM):
+        for sig in INTERRUPTS:
             previous[sig] = signal.signal(sig, _interrupt)
         sys.unraisablehook = _quiet_interrupts(hook)
     _SETTLED.clear()

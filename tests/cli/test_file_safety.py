@@ -285,7 +285,8 @@ def test_a_signal_during_reproduce_keeps_the_earlier_run(tmp_path, sig):
         assert sorted(p.name for p in tmp_path.iterdir() if p.name not in ("results", "numba-cache")) == []
 
 
-@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGKILL], ids=["SIGINT", "SIGTERM", "SIGKILL"])
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP, signal.SIGKILL],
+                         ids=["SIGINT", "SIGTERM", "SIGHUP", "SIGKILL"])
 def test_a_signal_during_a_sweep_keeps_the_earlier_file(tmp_path, sig):
     out = tmp_path / "sweep.csv"
     assert main(["plant", "sweep", "--out", str(out), "--voltages", "1.2:3.8:3", "--pump-speeds", "200:1000:3"]) == 0
