@@ -169,6 +169,16 @@ def test_mat_without_the_variable(tmp_path, capsys):
                            "--out", str(out)], "no column(s) ['y']; available columns are ['p', 'u']", out)
 
 
+def test_mat_with_a_variable_of_text_says_so(tmp_path, capsys):
+    """A text or cell variable was said to be missing ('no column(s) ['u']') although the file has it."""
+    path = tmp_path / "d.mat"
+    savemat(path, {"u": "hello", "y": np.arange(40.0)})
+    out = tmp_path / "m.json"
+    _expect_error(capsys, ["identify", str(path), "--input", "u", "--output", "y", "--na", "1", "--nb", "1",
+                           "--out", str(out)], "the variable(s) ['u'] hold no numbers (text, a cell array or a struct)",
+                  out)
+
+
 def test_mat_with_the_variables_works(tmp_path, capsys):
     path = tmp_path / "d.mat"
     d = make_system(5, rng=2, n=400)

@@ -458,6 +458,19 @@ def _loadmat_isolated(p: Path) -> dict:
                 for i, (name, kind) in enumerate(zip(meta["names"], meta["kinds"]))}
 
 
+def mat_non_numeric(path: str | os.PathLike) -> list[str]:
+    """The variables of a .mat file that are not read as columns because they hold no numbers
+    (text, cells, structs); ``[]`` for another format or an unreadable file."""
+    p = Path(path)
+    if p.suffix.lower() != ".mat":
+        return []
+    try:
+        raw = _loadmat_isolated(p)
+    except DataError:
+        return []
+    return sorted(name for name, value in raw.items() if not name.startswith("__") and value is None)
+
+
 def _read_mat(p: Path) -> dict[str, np.ndarray]:
     """Each variable of a MATLAB file becomes a column (vectors) or several (``name_1``... for matrices).
 
