@@ -376,7 +376,7 @@ def test_parquet_outputs_read_back_and_dash_is_standard_output(tmp_path, data_cs
     assert main(["predict", str(model), str(data_csv), "--out", "-", "--mode", "one-step"]) == 0
     printed, err = capsys.readouterr()
     lines = printed.splitlines()
-    assert lines[0] == "time_s,u1,u2,y,y_predicted,region" and len(lines) == 401 and "wrote -" in err
+    assert lines[0] == "time_s,u1,u2,y,y_predicted,region" and len(lines) == 401 and "wrote to standard output (400 rows" in err
     np.testing.assert_allclose([float(r.split(",")[4]) for r in lines[1:]], table["y_predicted"], rtol=1e-9)
     sweep = tmp_path / "s.parquet"
     assert main(["plant", "sweep", "--out", str(sweep), "--voltages", "1.2:3.8:3", "--pump-speeds", "200:1000:3"]) == 0

@@ -127,6 +127,11 @@ def _finite(obj):
     return obj
 
 
+def shown_path(path) -> str:
+    """An output path as "wrote ..." names it: ``-`` is "to standard output"."""
+    return "to standard output" if str(path) == "-" else str(path)
+
+
 def json_text(obj, indent: int | None = 2) -> str:
     """Strict JSON for standard output: a value that is not a finite number (a diverged fit) is
     ``null``, never ``NaN`` or ``Infinity``, which JSON does not have."""

@@ -9,7 +9,7 @@ import warnings
 
 import numpy as np
 
-from hwpts.commands._args import json_text
+from hwpts.commands._args import json_text, shown_path
 from hwpts.errors import DataError, ParameterError, SimulationError
 from hwpts.text import plain_int
 from hwpts.units import UNIT_SUFFIXES, unit_from_name
@@ -924,7 +924,7 @@ def cmd_predict(args) -> int:
     columns[f"{name}_predicted"] = yhat
     columns["region"] = regions + 1  # 1-based; 0 marks the initial conditions
     write_table(args.out, columns)
-    print(f"wrote {args.out} ({data.n_samples} rows, mode {mode}; region 0 = initial conditions)",
+    print(f"wrote {shown_path(args.out)} ({data.n_samples} rows, mode {mode}; region 0 = initial conditions)",
           file=sys.stderr if is_stdout(args.out) else sys.stdout)
     return 0
 

@@ -8,7 +8,8 @@ import sys
 
 import numpy as np
 
-from hwpts.commands._args import file_with_suffix, finite_float, grid, non_negative_float, non_negative_int
+from hwpts.commands._args import (file_with_suffix, finite_float, grid, non_negative_float, non_negative_int,
+                                  shown_path)
 from hwpts.errors import ParameterError, SimulationError
 
 INPUT_COLUMNS = ("time_s", "valve_voltage_v", "pump_speed_rpm")
@@ -125,7 +126,7 @@ def sweep_command(args) -> int:
     gap_rpm = float(np.max(np.abs(result.up_rpm - result.down_rpm)))
     gap = (f"largest hysteresis gap {np.max(np.abs(result.gap_percent)):.1f} % of full scale ({gap_rpm:.1f} r/min)"
            if result.points_per_sweep > 1 else f"hysteresis gap {gap_rpm:.1f} r/min (one operating point: no full scale)")
-    print(f"wrote {args.out}: {result.points_per_sweep} points per sweep (up, down, average); {gap}",
+    print(f"wrote {shown_path(args.out)}: {result.points_per_sweep} points per sweep (up, down, average); {gap}",
           file=sys.stderr if is_stdout(args.out) else sys.stdout)
     return 0
 
@@ -154,6 +155,6 @@ def simulate_command(args) -> int:
         except (DataError, SimulationError) as error:
             raise type(error)(f"--inputs {args.inputs!r}: {error}") from None
     write_table(args.out, dataset.columns())
-    print(f"wrote {args.out}: {dataset.n_samples} samples, {dataset.time[-1] - dataset.time[0]:.2f} s",
+    print(f"wrote {shown_path(args.out)}: {dataset.n_samples} samples, {dataset.time[-1] - dataset.time[0]:.2f} s",
           file=sys.stderr if is_stdout(args.out) else sys.stdout)
     return 0
