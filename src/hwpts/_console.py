@@ -38,8 +38,9 @@ def _interrupted() -> None:
 def entry() -> None:  # pragma: no cover - the console script, exercised in subprocess tests
     """Install the handlers, import and run :func:`hwpts.cli.main`, exit with its status."""
     try:
-        for sig in _INTERRUPTS:
-            _signal.signal(sig, _interrupt)
+        for sig in _INTERRUPTS:  # (a SIGHUP ignored by `nohup` stays ignored)
+            if not (sig == getattr(_signal, "SIGHUP", None) and _signal.getsignal(sig) == _signal.SIG_IGN):
+                _signal.signal(sig, _interrupt)
         from hwpts.cli import finish, main
 
         status = main()  # main restores these handlers, which then leave a late signal alone (_interrupt)

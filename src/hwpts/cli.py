@@ -114,6 +114,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     _INTERRUPTED.clear()
     if threading.current_thread() is threading.main_thread():
         for sig in INTERRUPTS:
+            if sig == getattr(signal, "SIGHUP", None) and signal.getsignal(sig) == signal.SIG_IGN:
+                continue  # `nohup hwpts ...`: the terminal closing is to leave the run alone
             previous[sig] = signal.signal(sig, _interrupt)
         sys.unraisablehook = _quiet_interrupts(hook)
     _SETTLED.clear()

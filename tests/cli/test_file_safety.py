@@ -583,3 +583,18 @@ def test_a_full_disk_behind_standard_output_names_the_stream_and_the_files_writt
         raise BrokenPipeError(errno.EPIPE, "Broken pipe")
 
     assert _run_with_handler(monkeypatch, piped) == 0
+
+
+def test_a_run_under_nohup_outlives_a_closed_terminal(tmp_path):
+    """SIGHUP stops a run as Ctrl-C does, unless the run was started to outlive its terminal
+    (`nohup`, which ignores SIGHUP): then it is left alone, as before the handler existed."""
+    out = tmp_path / "sweep.csv"
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba-cache"))
+    proc = subprocess.Popen([sys.executable, "-m", "hwpts", "plant", "sweep", "--out", str(out), "--voltages",
+                             "1.2:3.8:200", "--pump-speeds", "200:1000:150"], stderr=subprocess.PIPE,
+                            stdout=subprocess.PIPE, text=True, env=env,
+                            preexec_fn=lambda: signal.signal(signal.SIGHUP, signal.SIG_IGN))
+    time.sleep(1.5)
+    proc.send_signal(signal.SIGHUP)
+    _, err = proc.communicate(timeout=300)
+    assert proc.returncode == 0 and out.exists(), err
