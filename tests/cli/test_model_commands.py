@@ -188,12 +188,11 @@ def test_mat_with_the_variables_works(tmp_path, capsys):
     assert json.loads(capsys.readouterr().out)["n_regions"] == 1
 
 
-@pytest.mark.parametrize("name, scale", [("Time", 1.0), ("timestamp", 1.0), ("TIME_S", 1.0), ("time_ms", 1e3),
-                                         ("t_us", 1e6)])
+@pytest.mark.parametrize("name, scale", [("Time", 1.0), ("TIME_S", 1.0), ("time_ms", 1e3), ("t_us", 1e6)])
 def test_a_time_column_by_another_usual_name_is_the_time_axis(tmp_path, capsys, name, scale):
-    """A time column named Time (MATLAB and LabVIEW exports), timestamp or t_ms was read past: a
-    model of 100 Hz data was scored on data at 1 kHz without a word, and a model fitted on such a
-    file knew no sample time."""
+    """A time column named Time (MATLAB and LabVIEW exports) or t_ms was read past: a model of
+    100 Hz data was scored on data at 1 kHz without a word, and a model fitted on such a file knew
+    no sample time."""
     d = make_system(5, rng=2, n=400)
     signals = {"u1": d.inputs[:, 0], "u2": d.inputs[:, 1], "y": d.output}
     path, model = tmp_path / "d.csv", tmp_path / "m.json"
@@ -203,6 +202,18 @@ def test_a_time_column_by_another_usual_name_is_the_time_axis(tmp_path, capsys, 
     fast = tmp_path / "fast.csv"
     write_csv(fast, {name: scale * 0.001 * np.arange(400), **signals})
     _expect_error(capsys, ["validate", str(model), str(fast)], "sample time 0.001 s (1000 Hz) differs from the model's")
+
+
+def test_names_like_a_time_that_are_no_time_axis_are_left_alone(tmp_path, capsys):
+    """T_h (a temperature), t_min (a minimum) and a time_min column that does not increase are
+    signals, not the time axis (a T_h column made such files fail as 'time must be increasing')."""
+    d = make_system(5, rng=2, n=400)
+    rng = np.random.default_rng(0)
+    path = tmp_path / "d.csv"
+    write_csv(path, {"u1": d.inputs[:, 0], "u2": d.inputs[:, 1], "y": d.output, "T_h": 20 + rng.random(400),
+                     "t_min": rng.random(400), "time_min": rng.random(400), "timestamp": 1.7e12 + 10 * np.arange(400)})
+    assert main(["identify", str(path), *IDENTIFY, "--segmentation", "average", "--out", str(tmp_path / "m.json")]) == 0
+    assert json.loads(capsys.readouterr().out)["sample_time_s"] is None
 
 
 def test_mat_sample_time_variable(tmp_path, capsys):

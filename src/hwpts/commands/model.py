@@ -66,10 +66,11 @@ def _rows(text: str | None):
 
 # conventional names of a time column in seconds, tried in this order when --time is not given
 TIME_COLUMNS = ("time_s", "t_s", "time", "t")
-# other names taken as the time column (in the file's order, after those): any case of time,
-# timestamp, time_s, t_s, and time or t with a unit suffix (time_ms, t_us, Time_min, ...); a lone
-# upper-case T is left alone (a temperature as often as a time)
-TIME_PATTERN = re.compile(r"(time|timestamp|time_s|t_s|(time|t)_(ms|us|ns|min|h))", re.IGNORECASE)
+# other names taken as the time column (in the file's order, after those) when it holds increasing
+# numbers: time or time with a unit suffix in any case (Time, TIME_S, time_ms, Time_min, ...) and
+# t_ms, t_us, t_ns. Not a T with a suffix (T_h: a temperature), t_min or t_h (a minimum, a height),
+# nor timestamp (as often epoch milliseconds as seconds)
+TIME_PATTERN = re.compile(r"(?i:time(_(s|ms|us|ns|min|h))?)|t_(s|ms|us|ns)")
 NO_TIME = "none"  # --time none: no time column, the sample index is the time axis
 # a .mat file's scalar variable that gives the sample period in seconds (as MATLAB's iddata Ts),
 # tried in this order when the file has no time column and --time is not given
@@ -117,7 +118,10 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
     else:
         from hwpts.io.datasets import column_names
 
-        others = [c for c in column_names(path) if TIME_PATTERN.fullmatch(c) and c not in TIME_COLUMNS]
+        # (a .mat file is not read twice for its names: its time comes from a vector of the
+        # conventional names or its Ts)
+        names = column_names(path) if not str(path).lower().endswith(".mat") else []
+        others = [c for c in names if TIME_PATTERN.fullmatch(c) and c not in TIME_COLUMNS]
         candidates = [c for c in (*TIME_COLUMNS, *others) if c not in signals]
     try:
         columns = read_table(path, [*signals, *candidates])
@@ -161,7 +165,12 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
         if bad.any():  # said in the file's rows (the dataset counts within the selection)
             raise DataError(f"{str(path)!r}: column {name!r} has a non-finite value (NaN, inf or an empty cell) at "
                             f"row {offset + int(np.argmax(bad))} (data rows count from 0 after the header, as --rows)")
-    tname = next((c for c in candidates if c in cols), None)
+    # a column of a name beyond the conventional ones is the time axis only where it increases
+    # (T_h-like names aside, a time_min column of minima is no axis): else it is left alone
+    soft = [c for c in candidates if c in cols and c not in TIME_COLUMNS
+            and not (np.all(np.isfinite(np.asarray(cols[c], dtype=float)))
+                     and np.all(np.diff(np.asarray(cols[c], dtype=float)) > 0))]
+    tname = next((c for c in candidates if c in cols and c not in soft), None)
     period = _mat_sample_time(path, columns) if time_name is None else None
     detected = time_name is None and tname is not None
     hint = f" ({tname!r} is taken as the time column by its name; --time none uses the sample index)" if detected else ""
@@ -932,8 +941,8 @@ def cmd_predict(args) -> int:
 def _common_data_args(parser):
     parser.add_argument("--time", metavar="COL", default=None,
                         help="time column, in s unless its name ends in _ms, _us, _ns, _min or _h (default: the "
-                             "first of time_s, t_s, time, t present, then Time, timestamp, time_ms, ... in any "
-                             "case, else the sample index, or a .mat file's scalar Ts; 'none': the sample "
+                             "first of time_s, t_s, time, t present, then Time, time_ms, t_us, ... where they "
+                             "increase, else a .mat file's scalar Ts, else the sample index; 'none': the sample "
                              "index); its step is the sample time")
     parser.add_argument("--rows", metavar="START:STOP", default=None,
                         help="use only these rows (Python slice: 0:5000; write --rows=-1001: for a negative start)")
