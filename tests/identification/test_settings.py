@@ -393,7 +393,10 @@ def test_a_time_indexed_frame_gives_its_sample_time_and_data_at_another_rate_are
         model.score(pd.DataFrame({"u": u[:, 0]}, index=fast), pd.Series(y, index=fast))
     with pytest.raises(ParameterError, match="sample_time 0.5 s differs from the DataFrame's time index"):
         PWARX(1, 1, 1).fit(frame, output, sample_time=0.5)
+    # an index with a gap gives no sample time (the gap is the fit's breaks to say), as arrays
     gap = index[:-1].append(pd.DatetimeIndex([index[-1] + pd.Timedelta("4s")]))
-    with pytest.raises(DataError, match="time index is not uniformly sampled"):
-        PWARX(1, 1, 1).fit(pd.DataFrame({"u": u[:, 0]}, index=gap), y)
+    gapped = PWARX(1, 1, 1, segmentation="threshold").fit(pd.DataFrame({"u": u[:, 0]}, index=gap), y, breaks=[599])
+    assert gapped.sample_time_ is None
+    assert np.isfinite(gapped.score(pd.DataFrame({"u": u[:, 0]}, index=gap), y))
+    assert np.isfinite(model.score(pd.DataFrame({"u": u[:, 0]}, index=gap), y))
     assert model.score(u, y) == model.score(frame, output)  # arrays carry no rate to check

@@ -313,8 +313,9 @@ class PWARX(BaseEstimator):
         """Identify the model from inputs ``X`` (n, n_inputs) and output ``y`` (n,), or an IODataset.
 
         ``X`` may be a pandas DataFrame: its column names become the input names, and later
-        predictions select the columns by name (in any order); indexed by time stamps or
-        durations, its step is the sample time (a time index at another rate is refused later).
+        predictions select the columns by name (in any order); indexed by uniformly spaced time
+        stamps or durations, its step is the sample time (a time index at another rate is refused
+        later; one with a gap gives none).
         ``y`` may have shape (n, 1).
         ``input_names`` (one per input) and ``output_name`` name plain arrays' signals (default
         ``u1, u2, ...`` and ``y``, or a named Series' name); an IODataset names its own.
@@ -461,7 +462,7 @@ class PWARX(BaseEstimator):
         else:
             _check_index(X, y)
             known = getattr(self, "sample_time_", None)
-            dt = frame_sample_time(X, remedy="resample the data")
+            dt = frame_sample_time(X)
             if known is not None and dt is not None and abs(dt - known) > 0.01 * known:
                 raise DataError(f"the DataFrame's time index is sampled every {dt:.6g} s, the model every "
                                 f"{known:.6g} s: its lags would mean other delays; resample the data or refit")
@@ -677,13 +678,18 @@ def frame_time(X) -> np.ndarray | None:
     return values.astype("timedelta64[ns]").astype(np.int64) / 1e9
 
 
-def frame_sample_time(X, what: str = "the DataFrame's time index", remedy: str = "resample it") -> float | None:
-    """The sample period [s] of a pandas object indexed by time (:func:`frame_time`), else None; a
-    time index that is not uniform is refused as a dataset's time is."""
+def frame_sample_time(X) -> float | None:
+    """The sample period [s] of a pandas object indexed by uniformly spaced time stamps or
+    durations (:func:`frame_time`), else None: an index with a gap (rows dropped, records joined:
+    ``fit(..., breaks=...)`` says where) or jitter gives no sample time, as arrays give none, and
+    an unsorted one is refused by the fit."""
     time = frame_time(X)
-    if time is None or time.size < 2 or np.any(np.diff(time) <= 0):  # (an unsorted index is said by the fit)
+    if time is None or time.size < 2 or np.any(np.diff(time) <= 0):
         return None
-    return IODataset(time, np.zeros((time.size, 1)), np.zeros(time.size), ("u",), "y").uniform_sample_time(what, remedy)
+    try:
+        return IODataset(time, np.zeros((time.size, 1)), np.zeros(time.size), ("u",), "y").uniform_sample_time()
+    except DataError:
+        return None
 
 
 def data_sample_time(X, sample_time):
@@ -693,7 +699,7 @@ def data_sample_time(X, sample_time):
         return dataset_sample_time(X, sample_time)
     from hwpts.identification.settings import is_number
 
-    uniform = frame_sample_time(X, remedy=LIBRARY_REMEDY)
+    uniform = frame_sample_time(X)
     if uniform is None or sample_time is None:
         return uniform if sample_time is None else sample_time
     if is_number(sample_time, strict=True) and abs(sample_time - uniform) > 0.01 * uniform:
