@@ -203,6 +203,25 @@ def test_what_would_be_ignored_is_refused():
         PWARX(1, 1, 1).fit(data, input_names=["zz"])
     with pytest.raises(DataError, match="inputs holds text"):
         PWARX(1, 1, 1).fit(u.astype(str), y)
+    with pytest.raises(DataError, match="inputs holds text"):  # an object array (a DataFrame's strings) alike
+        PWARX(1, 1, 1).fit(u.astype(str).astype(object), y)
+    with pytest.raises(DataError, match="initial_output holds text"):
+        model.simulate(u, initial_output=["0.1", "0.2"])
+    PWARX(1, 1, 1, segmentation="average", n_regions=1).fit(u.astype(object), y)  # numbers in objects: numbers
+
+
+def test_settings_that_worked_before_their_checks_still_do():
+    """A whole float for n_grid, no trimming (None), no regularisation (infinity) were refused by
+    the first version of these checks."""
+    from hwpts.identification.partition import PartitionLearner
+
+    u, y = two_modes()
+    PWARX(1, 1, 1, segmentation="threshold", segmentation_params={"n_grid": 50.0}).fit(u, y)
+    X = np.column_stack([y[:-1], u[:-1, 0]])
+    labels = (X[:, 0] >= 0).astype(int)
+    for setting in ({"trim": None}, {"C": np.inf}, {"confidence_margin": np.inf}, {"separable_C": None}):
+        learned, _, _ = PartitionLearner(random_state=0, **setting).learn(X, y[1:], labels, 2)
+        assert np.mean(learned == labels) > 0.95, setting
 
 
 def test_a_score_against_a_measured_nan_is_an_error():
@@ -265,7 +284,7 @@ def test_segmenter_settings_are_checked(method, params, match):
     (PWARX(1, 1, 1), {"n_regions": [2, "x"]}, "n_regions must be an int >= 1, got 'x'"),
     (PWARX(1, 1, 1), {"output_order": [1, -2]}, "na \\(output order\\) must be an int >= 0, got -2"),
     (PWARX(1, 1, 1), {"ridge": [0, -1]}, "ridge must be a number >= 0, got -1"),
-    (PWARX(1, 1, 1), {"segmentation": ["auto"]}, "segmentation 'auto' is the search itself"),
+    (PWARX(1, 1, 1), {"segmentation": ["auto"]}, "segmentation 'auto' is a model search, not a model"),
     (PWARX(1, 1, 1), {"segmentation": ["threshold"], "segmentation_params": [{"n_grid": 1}]},
      "threshold: n_grid must be an int >= 2, got 1"),
     (PWARX(-1, 1, 1), None, "^PWARXSearch: na \\(output order\\) must be an int >= 0, got -1"),
@@ -277,6 +296,20 @@ def test_a_bad_value_in_the_grid_or_the_estimator_is_said_before_any_fit(estimat
     u, y = two_modes()
     with pytest.raises(ParameterError, match=match):
         PWARXSearch(estimator, grid).fit(u, y)
+
+
+def test_the_estimators_method_settings_are_the_candidates_to_check():
+    """The base's own method is replaced by every candidate's: its settings are checked with the
+    candidate's method, not with the method the base names (that refused hyperplanes a grid's
+    'hyperplane' candidates use, and a threshold setting beside the default 'clustering')."""
+    u, y = two_modes()
+    search = PWARXSearch(PWARX(1, 1, 1, hyperplanes=["1,0@y(k-1)"]), {"segmentation": ["hyperplane"]}).fit(u, y)
+    assert search.best_params_ == {"segmentation": "hyperplane"}
+    search = PWARXSearch(PWARX(1, 1, 1, segmentation_params={"min_share": 0.2}, random_state=0),
+                         {"segmentation": ["threshold", "threshold-alternating"]}).fit(u, y)
+    assert search.best_params_["segmentation"] in ("threshold", "threshold-alternating")
+    with pytest.raises(ParameterError, match="output_order must be an int >= 0 .* got None"):
+        PWARXSearch(PWARX(1, 1, 1), {"output_order": [None, 1]}).fit(u, y)
 
 
 def test_one_partition_column_name_is_one_column_and_an_empty_simulation_is_refused():

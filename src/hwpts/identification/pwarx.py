@@ -246,9 +246,10 @@ class PWARX(BaseEstimator):
         """``(na, nb, nk)`` this model is fitted with: its orders, 1 for each left ``None``."""
         return tuple(1 if v is None else v for v in (self.output_order, self.input_order, self.input_delay))
 
-    def _check_settings(self):
+    def _check_settings(self, segmenter: bool = True):
         """One line naming the setting, what it takes and what it got, before any fit (the orders,
-        regions and rows are checked where they are used)."""
+        regions and rows are checked where they are used); ``segmenter``: the method's own settings
+        too (not for a model search's base, whose method the candidates replace)."""
         from hwpts.identification.settings import check_bool, check_count, check_number, is_count
 
         for name in ("constant", "polish", "sparse_partition"):
@@ -284,7 +285,7 @@ class PWARX(BaseEstimator):
             shown = seed if isinstance(seed, (bool, str, bytes, float, int)) else type(seed).__name__
             raise ParameterError(f"random_state must be None, an int >= 0 or a numpy Generator or SeedSequence, "
                                  f"got {shown!r}") from None
-        if not (isinstance(self.segmentation, str) and self.segmentation == "auto"):  # (a search's base may say it)
+        if segmenter:
             self._segmenter().check_params()  # the method's own settings (segmentation_params)
 
     def _segmenter(self):
@@ -550,7 +551,7 @@ class PWARX(BaseEstimator):
                 raise ParameterError("simulate takes the initial outputs from initial_output or from the measured "
                                      "output (y, or an IODataset's), not both")
             u, _ = self._check_inputs(X, None, need_y=False)
-            y0 = np.asarray(initial_output, dtype=float)
+            y0 = dense_real(initial_output, "initial_output")
             if y0.ndim > 1 and sum(d > 1 for d in y0.shape) > 1:
                 raise DataError(f"initial_output must be a vector of the first outputs, got shape {y0.shape}")
             y0 = y0.ravel()

@@ -338,7 +338,9 @@ def dense_real(values, label: str) -> np.ndarray:
     if arr.dtype.kind in "mM":  # numpy casts dates to nanosecond counts without a word
         raise DataError(f"{label} holds dates or durations ({arr.dtype}); hwpts models numeric signals (pass the "
                         f"time as the dataset's time axis, not as a signal)")
-    if arr.dtype.kind in "US":  # as scikit-learn: text is not read as numbers, even where it could be
+    if arr.dtype.kind in "US" or (arr.dtype.kind == "O" and any(isinstance(v, (str, bytes)) for v in arr.flat)):
+        # as scikit-learn: text is not read as numbers, even where it could be (a DataFrame column
+        # of strings, an object array, a numpy array of text alike)
         raise DataError(f"{label} holds text ({arr.dtype}); convert it to numbers first "
                         f"({label}.astype(float) where every entry is one)")
     if arr.dtype.kind not in "biuf":

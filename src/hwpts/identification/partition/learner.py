@@ -111,16 +111,25 @@ class PartitionLearner(BaseEstimator):
         from hwpts.identification.settings import check_bool, check_count, check_number
 
         owner = "PartitionLearner: "
+
+        def positive(value, name, allow_none=False):  # > 0, infinity included (no regularisation)
+            if (value is None and allow_none) or (not isinstance(value, bool) and isinstance(
+                    value, (int, float, np.integer, np.floating)) and value > 0):
+                return
+            raise ParameterError(f"{owner}{name} must be a number > 0{' or None' if allow_none else ''}, "
+                                 f"got {value!r}")
+
         check_count(self.refinement_rounds, "refinement_rounds", 0, owner)
-        check_number(self.C, "C", strict=True, owner=owner)
+        positive(self.C, "C")
         check_number(self.ridge, "ridge", owner=owner)
         check_bool(self.sparse, "sparse", owner)
-        check_number(self.confidence_margin, "confidence_margin", owner=owner)
+        if not (not isinstance(self.confidence_margin, bool) and isinstance(
+                self.confidence_margin, (int, float, np.integer, np.floating)) and self.confidence_margin >= 0):
+            raise ParameterError(f"{owner}confidence_margin must be a number >= 0, got {self.confidence_margin!r}")
         check_count(self.classifier_rows, "classifier_rows", 100, owner)
         check_number(self.sparse_tol, "sparse_tol", owner=owner)
-        check_number(self.trim, "trim", strict=True, owner=owner)
-        if self.separable_C is not None:
-            check_number(self.separable_C, "separable_C", strict=True, owner=owner)
+        positive(self.trim, "trim", allow_none=True)  # None: no trimming (fit_local_models)
+        positive(self.separable_C, "separable_C", allow_none=True)
         try:
             np.random.default_rng(self.random_state)
         except (TypeError, ValueError):

@@ -316,12 +316,14 @@ def _cholesky_sse(C, ia, ib, pairs, p, ridge):
 
 def check_split_params(segmenter, owner: str) -> None:
     """The threshold split's settings (``column``, ``n_grid``, ``min_share``) of ``segmenter``."""
-    from hwpts.identification.settings import check_count, is_number
+    from hwpts.identification.settings import is_count, is_number
 
     if segmenter.column is not None and not isinstance(segmenter.column, str):
         raise ParameterError(f"{owner}column must be a regressor column name such as 'y(k-1)' or None, "
                              f"got {segmenter.column!r}")
-    check_count(segmenter.n_grid, "n_grid", 2, owner)
+    n_grid = segmenter.n_grid  # a whole float (2.0) is read as its int, as before these checks
+    if not (is_count(n_grid, 2) or (is_number(n_grid, 2.0) and float(n_grid).is_integer())):
+        raise ParameterError(f"{owner}n_grid must be an int >= 2, got {n_grid!r}")
     if not (is_number(segmenter.min_share, 0.0, strict=True) and segmenter.min_share < 0.5):
         raise ParameterError(f"{owner}min_share must be a number in (0, 0.5) (each region's least share of "
                              f"the rows), got {segmenter.min_share!r}")

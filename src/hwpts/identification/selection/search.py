@@ -601,7 +601,9 @@ class PWARXSearch(BaseEstimator):
         check_fit_arguments(sample_time, units, output_name)
         self._check_params()
         base = self._base()
-        base._check_settings()  # a bad estimator setting is said as PWARX says it, not as every candidate failing
+        # a bad estimator setting is said as PWARX says it, not as every candidate failing (its
+        # method's own settings are the candidates', which replace the method: checked with them)
+        base._check_settings(segmenter=False)
         u, yy, names, oname = base._signals(X, y, input_names, output_name)
         self._check_orders(base, u.shape[1])
         if np.ptp(yy) == 0:
@@ -686,11 +688,12 @@ class PWARXSearch(BaseEstimator):
             estimator._check_settings()
         except (ParameterError, TypeError, ValueError) as error:
             raise ParameterError(f"{owner}{error}") from None
+        for key in ("output_order", "input_order", "input_delay"):
+            if key in params and params[key] is None:  # a grid gives its orders; the search fills no None
+                raise ParameterError(f"{owner}{key} must be an int >= 0 (or one per input), got None; leave it "
+                                     f"out of the grid for the estimator's own")
         if not is_count(estimator.n_regions, 1):
             raise ParameterError(f"{owner}n_regions must be an int >= 1, got {estimator.n_regions!r}")
-        if isinstance(estimator.segmentation, str) and estimator.segmentation == "auto":
-            raise ParameterError(f"{owner}segmentation 'auto' is the search itself; give the methods to try, "
-                                 f"e.g. 'segmentation': ['threshold', 'alternating']")
         self._check_orders(estimator, n_inputs, owner)
 
     @staticmethod
