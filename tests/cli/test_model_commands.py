@@ -216,6 +216,15 @@ def test_names_like_a_time_that_are_no_time_axis_are_left_alone(tmp_path, capsys
     assert json.loads(capsys.readouterr().out)["sample_time_s"] is None
 
 
+def test_zero_region_with_a_method_of_its_own_count(tmp_path, data_csv, capsys):
+    """zscore always makes 2 regions: --zero-region 2 needed --regions 2 as well."""
+    out = tmp_path / "z.json"
+    assert main(["identify", str(data_csv), *IDENTIFY, "--segmentation", "zscore", "--zero-region", "2",
+                 "--out", str(out)]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert [r["model"] for r in summary["regions"]] == ["affine", "zero"]
+
+
 def test_mat_sample_time_variable(tmp_path, capsys):
     """A .mat file's scalar Ts (as MATLAB's iddata) is its sample time when it has no time column;
     a time column that disagrees with it, or a Ts that is no period, is refused."""

@@ -124,8 +124,8 @@ def test_controller_lists_have_no_empty_names_and_scheduler_ports_are_ports():
         with pytest.raises(ParameterError, match="an empty name"):
             parse_names(text)
     assert is_address("tcp://127.0.0.1:8786") and not is_address("tcp://127.0.0.1:99999")
-    assert is_address("localhost:8786") and is_address("[::1]:8786")
-    assert not is_address("tcp://256.1.1.1:1") and not is_address("1.2.3:80")  # no IPv4 address: refused at once
+    assert is_address("localhost:8786") and is_address("[::1]:8786") and is_address("127.1:8786")
+    assert not is_address("tcp://256.1.1.1:1") and not is_address("999.1:80")  # no IPv4 address: refused at once
 
 
 def test_low_wind_no_windup_and_recovery(paper_model_doc):

@@ -81,7 +81,8 @@ def register(subparsers) -> None:
     r.add_argument("--duration", type=_duration, default=None, metavar="S", help="shorter or longer record than the "
                    "scenario's own (turbulence: 600 s)")
     r.add_argument("--seed", type=non_negative_int, default=0, metavar="N", help="seed of wind and sensor noise (default 0)")
-    r.add_argument("--out", required=True, metavar="DIR", help="output folder (an earlier run there is replaced)")
+    r.add_argument("--out", required=True, metavar="DIR", help="output folder (an earlier run there is replaced; a folder holding "
+                   "other files is refused)")
     r.set_defaults(handler=run_command)
     st = sub.add_parser("study", help="Monte-Carlo study over perturbed plants x wind seeds x controllers on Dask",
                         description="Run the controllers on perturbed plants (parameters within documented tolerances) "
@@ -101,7 +102,8 @@ def register(subparsers) -> None:
     st.add_argument("--hysteresis-width", type=finite_float, default=None, metavar="V", help="the model's play half-width [V]")
     st.add_argument("--duration", type=_duration, default=None, metavar="S", help="record length (default: the scenario's, 600 s)")
     st.add_argument("--seed", type=non_negative_int, default=0, metavar="N", help="seed of the plant draws (default 0)")
-    st.add_argument("--out", required=True, metavar="DIR", help="output folder (an earlier study there is replaced)")
+    st.add_argument("--out", required=True, metavar="DIR", help="output folder (an earlier study there is replaced; a folder holding "
+                    "other files is refused)")
     st.set_defaults(handler=study_command)
 
 
@@ -278,8 +280,8 @@ def run_command(args) -> int:
         try:
             summary, runs, scenario = run_scenario(bank, half_width, args.scenario, names, args.seed,
                                                    args.setpoint, args.duration, source, progress)
-        except UnreachableSetpoint as error:
-            raise ParameterError(f"--setpoint {args.setpoint:g}: {error}") from None
+        except UnreachableSetpoint as error:  # (the scenario may step it: setpoint-step goes 5 % above)
+            raise ParameterError(f"--setpoint {args.setpoint:g} (scenario {args.scenario}): {error}") from None
     with staged_folder(args.out, SCHEMA) as stage:
         for name, result in runs.items():
             write_csv(stage / "data" / f"{name}.csv", result.columns)

@@ -639,7 +639,11 @@ def cmd_identify(args) -> int:
         if low < 1:  # said before what the count needs: regions are numbered from 1 whatever it is
             raise ParameterError(f"--zero-region: expected a region number >= 1 (regions are numbered from 1), "
                                  f"got {low}")
-        n_hyper = len(hyperplanes) + 1 if segmentation == "hyperplane" else n_regions
+        own = getattr(SEGMENTATION_METHODS.get(segmentation), "fixed_regions", None)  # zscore's 2
+        n_hyper = len(hyperplanes) + 1 if segmentation == "hyperplane" else own if own is not None else n_regions
+        if n_hyper == 1:
+            raise ParameterError("--zero-region: a model of one region as the zero mode y = 0 leaves nothing to "
+                                 "fit; give --regions 2 or more")
         if not isinstance(n_hyper, int):
             raise ParameterError("--zero-region needs a fixed number of regions (--regions S or hyperplanes)")
         region_models = ["affine"] * n_hyper

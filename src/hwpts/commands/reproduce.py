@@ -22,7 +22,8 @@ def register(subparsers) -> None:
         "DIR/models/*.json and prints the fit table.",
     )
     p.add_argument("--out", default="results", metavar="DIR", help="output folder (default: results); an earlier "
-                   "run there is replaced as a whole, any other non-empty folder is refused")
+                   "run there is replaced as a whole; a folder holding files a run did not write (or without "
+                   "its list of them) is refused")
     p.add_argument("--quick", action="store_true", help="a smaller run (same outputs), for tests")
     p.add_argument("--seed", type=non_negative_int, default=0, metavar="N", help="seed of every random choice (default 0)")
     p.set_defaults(handler=reproduce_command)

@@ -126,16 +126,16 @@ def is_address(text: str) -> bool:
     """Whether ``text`` is a scheduler address hwpts connects to: ``tcp://HOST:PORT`` or ``HOST:PORT``."""
     import re
 
-    import ipaddress
+    import socket
 
     found = re.fullmatch(r"(tcp://)?([A-Za-z0-9_.\-\[\]:]+):(\d{1,5})", str(text))
     if not found or not 1 <= int(found.group(3)) <= 65535:  # a port number (99999 waited 10 s to fail)
         return False
     host = found.group(2)
-    if re.fullmatch(r"[\d.]+", host):  # numbers and dots: an IPv4 address (256.1.1.1 waited 10 s to fail)
-        try:
-            ipaddress.IPv4Address(host)
-        except ValueError:
+    if re.fullmatch(r"[\d.]+", host):  # numbers and dots: an IPv4 address (256.1.1.1 waited 10 s to fail),
+        try:  # in any form the system's resolver takes (127.1 too)
+            socket.inet_aton(host)
+        except OSError:
             return False
     return True
 
