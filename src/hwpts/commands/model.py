@@ -74,7 +74,7 @@ TIME_PATTERN = re.compile(r"(?i:time(_(s|ms|us|ns|min|h))?)|t_(s|ms|us|ns)")
 NO_TIME = "none"  # --time none: no time column, the sample index is the time axis
 # a .mat file's scalar variable that gives the sample period in seconds (as MATLAB's iddata Ts),
 # tried in this order when the file has no time column and --time is not given
-MAT_SAMPLE_TIMES = ("Ts", "ts", "dt", "sample_time", "sample_time_s")
+MAT_SAMPLE_TIMES = ("Ts", "dt", "sample_time", "sample_time_s")  # (not ts: a settling time as often)
 
 
 def _available(path, found) -> str:
@@ -216,7 +216,8 @@ def _mat_sample_time(path, columns) -> tuple[str, float] | None:
         value = float(np.asarray(value, dtype=float).reshape(-1)[0])
         if not (np.isfinite(value) and value > 0):
             raise DataError(f"{str(path)!r}: the variable {name!r} is taken as the sample time in seconds; expected "
-                            f"a positive number, got {value:g} (pass --time none to use the sample index)")
+                            f"a positive number, got {value:g} (pass --time COL for a time column, or --time none for "
+                            f"the sample index)")
         return name, value
     return None
 
