@@ -419,6 +419,10 @@ def test_a_time_indexed_frame_gives_its_sample_time_and_data_at_another_rate_are
     model = PWARX(1, 1, 1, segmentation="threshold", random_state=0).fit(frame, output)
     assert model.sample_time_ == 0.01
     assert PWARXSearch(PWARX(1, 1, 1, random_state=0), methods="threshold").fit(frame, output).best_estimator_.sample_time_ == 0.01
+    periods = pd.period_range("2024-01-01", periods=y.size, freq="s")
+    assert PWARX(1, 1, 1, segmentation="threshold").fit(pd.DataFrame({"u": u[:, 0]}, index=periods), y).sample_time_ == 1.0
+    with pytest.raises(DataError, match="time index is sampled every 1 s, the model every 0.01 s"):
+        model.score(pd.DataFrame({"u": u[:, 0]}, index=periods), pd.Series(y, index=periods))
     steps = pd.timedelta_range(0, periods=y.size, freq="20ms")
     assert PWARX(1, 1, 1, segmentation="threshold").fit(pd.DataFrame({"u": u[:, 0]}, index=steps), y).sample_time_ == 0.02
     fast = pd.date_range("2024-01-01", periods=y.size, freq="1ms")

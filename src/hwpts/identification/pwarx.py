@@ -668,9 +668,12 @@ LIBRARY_REMEDY = ("resample it, or fit the arrays with breaks at the gaps: "
 
 
 def frame_time(X) -> np.ndarray | None:
-    """The time [s] of a pandas object indexed by time stamps or durations (a DatetimeIndex or a
-    TimedeltaIndex), else None (a numeric index may count samples as well as seconds)."""
+    """The time [s] of a pandas object indexed by time stamps, periods or durations (a
+    DatetimeIndex, PeriodIndex or TimedeltaIndex), else None (a numeric index may count samples as
+    well as seconds)."""
     index = getattr(X, "index", None)
+    if type(index).__name__ == "PeriodIndex":  # periods (a 1 s PeriodIndex): their start times
+        index = index.to_timestamp()
     if index is None or not hasattr(index, "dtype") or getattr(index.dtype, "kind", None) not in ("M", "m"):
         return None
     values = np.asarray(index.values)
