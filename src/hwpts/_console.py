@@ -16,8 +16,14 @@ import sys
 
 import _signal  # the C module: ``signal`` imports ``enum`` first, 10 ms more of the window
 
-# Ctrl-C, SIGTERM and SIGHUP (the terminal closed; POSIX only), as hwpts.cli.INTERRUPTS
-_INTERRUPTS = tuple(getattr(_signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(_signal, name))
+
+def interrupt_signals() -> tuple:
+    """The signals that stop a run as Ctrl-C does: SIGINT, SIGTERM and SIGHUP (the terminal
+    closed; POSIX only), but not a SIGHUP the process ignores (started under ``nohup``: the
+    terminal closing is to leave the run alone). The console script, :func:`hwpts.cli.main` and
+    the Dask cluster's start use this one list."""
+    return tuple(getattr(_signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(_signal, name)
+                 and not (name == "SIGHUP" and _signal.getsignal(_signal.SIGHUP) == _signal.SIG_IGN))
 
 
 def _interrupt(signum, frame):
@@ -38,13 +44,13 @@ def _interrupted() -> None:
 def entry() -> None:  # pragma: no cover - the console script, exercised in subprocess tests
     """Install the handlers, import and run :func:`hwpts.cli.main`, exit with its status."""
     try:
-        for sig in _INTERRUPTS:  # (a SIGHUP ignored by `nohup` stays ignored)
-            if not (sig == getattr(_signal, "SIGHUP", None) and _signal.getsignal(sig) == _signal.SIG_IGN):
-                _signal.signal(sig, _interrupt)
+        handled = interrupt_signals()
+        for sig in handled:
+            _signal.signal(sig, _interrupt)
         from hwpts.cli import finish, main
 
         status = main()  # main restores these handlers, which then leave a late signal alone (_interrupt)
-        for sig in _INTERRUPTS:
+        for sig in handled:
             _signal.signal(sig, _signal.SIG_IGN)
     except KeyboardInterrupt:
         _interrupted()

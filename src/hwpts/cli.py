@@ -78,10 +78,6 @@ def _check_outputs(args) -> None:
                                  f"replaced as a whole, which would delete it; choose another output folder")
 
 
-# the signals that stop a run as Ctrl-C does (SIGHUP: the terminal closed; POSIX only)
-INTERRUPTS = tuple(getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, name))
-
-
 def _interrupt(signum, frame):  # pragma: no cover - exercised in a subprocess test
     _INTERRUPTED.set()
     if _COMMITTING.is_set() or _SETTLED.is_set():  # inside a commit, or the run is over: recorded,
@@ -113,9 +109,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     hook = sys.unraisablehook
     _INTERRUPTED.clear()
     if threading.current_thread() is threading.main_thread():
-        for sig in INTERRUPTS:
-            if sig == getattr(signal, "SIGHUP", None) and signal.getsignal(sig) == signal.SIG_IGN:
-                continue  # `nohup hwpts ...`: the terminal closing is to leave the run alone
+        from hwpts._console import interrupt_signals
+
+        for sig in interrupt_signals():
             previous[sig] = signal.signal(sig, _interrupt)
         sys.unraisablehook = _quiet_interrupts(hook)
     _SETTLED.clear()

@@ -101,33 +101,8 @@ class IODataset:
 
     def uniform_sample_time(self, what: str = "the time column",
                             remedy: str = "resample the data, or split the record at the gap") -> float | None:
-        """The sample period [s] when the time axis is uniform (every step within 1 % of the
-        median; ``None`` for fewer than two samples), else a :class:`DataError` naming the first
-        row where it is not: lagged regressors across a gap or a jitter mean other delays."""
-        if self.n_samples < 2:
-            return None
-        steps = np.diff(self.time)
-        dt = float(f"{float(np.median(steps)):.12g}")  # 0.01, not 0.009999999999999787 from the time column's rounding
-        worst = float(np.max(np.abs(steps - dt)))
-        if worst > 0.01 * dt and np.array_equal(self.time, self.time.astype(np.float32)):
-            # a single-precision time axis (MATLAB single, float32 Parquet): a uniform grid rounded
-            # to float32 has steps off by its spacing at the largest time (at 1000 s, 6e-5 s: 60 % of
-            # a 10 kHz step); it is uniform when rounding the least-squares grid gives it back
-            k = np.arange(self.n_samples) - 0.5 * (self.n_samples - 1)
-            slope = float(np.dot(k, self.time - self.time.mean()) / np.dot(k, k))
-            grid = self.time.mean() + k * slope
-            if np.max(np.abs(grid.astype(np.float32) - self.time)) <= np.spacing(np.float32(np.max(np.abs(self.time)))):
-                return float(f"{slope:.6g}")
-        if worst > 0.01 * dt:
-            row = int(np.argmax(np.abs(steps - dt))) + 1
-            raise DataError(f"{what} is not uniformly sampled (step {dt:.6g} s, but {steps[row - 1]:.6g} s at row "
-                            f"{row}); PWARX models need a constant sample time: {remedy}")
-        # the mean step, to the fewest digits the time values' own resolution allows: each step of
-        # an epoch axis (1.7e9 s) is rounded to 2.4e-7 s, and the median gave 0.000999927520752 s
-        # for 1 ms; the mean over the record is n times finer
-        mean = float(self.time[-1] - self.time[0]) / (self.n_samples - 1)
-        tol = 2.0 * float(np.spacing(np.max(np.abs(self.time)))) / (self.n_samples - 1)
-        return next((float(f"{mean:.{d}g}") for d in range(6, 18) if abs(float(f"{mean:.{d}g}") - mean) <= tol), mean)
+        """The sample period [s] when the time axis is uniform (:func:`uniform_sample_time`)."""
+        return uniform_sample_time(self.time, what, remedy)
 
     def input(self, name: str) -> np.ndarray:
         """One input column by name."""
@@ -187,3 +162,36 @@ class IODataset:
             time = np.arange(n) * float(sample_time)
         inputs = np.column_stack([np.asarray(columns[c], dtype=float) for c in input_names])
         return cls(time, inputs, columns[output_name], tuple(input_names), output_name)
+
+
+def uniform_sample_time(time, what: str = "the time column",
+                        remedy: str = "resample the data, or split the record at the gap") -> float | None:
+    """The sample period [s] of the times ``time`` when they are uniform (every step within 1 % of
+    the median; ``None`` for fewer than two samples), else a :class:`DataError` naming the first
+    row where they are not: lagged regressors across a gap or a jitter mean other delays."""
+    time = np.asarray(time, dtype=float)
+    n = time.size
+    if n < 2:
+        return None
+    steps = np.diff(time)
+    dt = float(f"{float(np.median(steps)):.12g}")  # 0.01, not 0.009999999999999787 from the time column's rounding
+    worst = float(np.max(np.abs(steps - dt)))
+    if worst > 0.01 * dt and np.array_equal(time, time.astype(np.float32)):
+        # a single-precision time axis (MATLAB single, float32 Parquet): a uniform grid rounded
+        # to float32 has steps off by its spacing at the largest time (at 1000 s, 6e-5 s: 60 % of
+        # a 10 kHz step); it is uniform when rounding the least-squares grid gives it back
+        k = np.arange(n) - 0.5 * (n - 1)
+        slope = float(np.dot(k, time - time.mean()) / np.dot(k, k))
+        grid = time.mean() + k * slope
+        if np.max(np.abs(grid.astype(np.float32) - time)) <= np.spacing(np.float32(np.max(np.abs(time)))):
+            return float(f"{slope:.6g}")
+    if worst > 0.01 * dt:
+        row = int(np.argmax(np.abs(steps - dt))) + 1
+        raise DataError(f"{what} is not uniformly sampled (step {dt:.6g} s, but {steps[row - 1]:.6g} s at row "
+                        f"{row}); PWARX models need a constant sample time: {remedy}")
+    # the mean step, to the fewest digits the time values' own resolution allows: each step of
+    # an epoch axis (1.7e9 s) is rounded to 2.4e-7 s, and the median gave 0.000999927520752 s
+    # for 1 ms; the mean over the record is n times finer
+    mean = float(time[-1] - time[0]) / (n - 1)
+    tol = 2.0 * float(np.spacing(np.max(np.abs(time)))) / (n - 1)
+    return next((float(f"{mean:.{d}g}") for d in range(6, 18) if abs(float(f"{mean:.{d}g}") - mean) <= tol), mean)

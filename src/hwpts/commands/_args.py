@@ -129,7 +129,9 @@ def _finite(obj):
 
 def shown_path(path) -> str:
     """An output path as "wrote ..." names it: ``-`` is "to standard output"."""
-    return "to standard output" if str(path) == "-" else str(path)
+    from hwpts.io.datasets import is_stdout
+
+    return "to standard output" if is_stdout(path) else str(path)
 
 
 def json_text(obj, indent: int | None = 2) -> str:

@@ -118,10 +118,9 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
     else:
         from hwpts.io.datasets import column_names
 
-        # (a .mat file is not read twice for its names: its time comes from a vector of the
+        # (none from a .mat file, not read twice for its names: its time is a vector of the
         # conventional names or its Ts)
-        names = column_names(path) if not str(path).lower().endswith(".mat") else []
-        others = [c for c in names if TIME_PATTERN.fullmatch(c) and c not in TIME_COLUMNS]
+        others = [c for c in column_names(path) if TIME_PATTERN.fullmatch(c) and c not in TIME_COLUMNS]
         candidates = [c for c in (*TIME_COLUMNS, *others) if c not in signals]
     try:
         columns = read_table(path, [*signals, *candidates])

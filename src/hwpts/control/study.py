@@ -196,8 +196,9 @@ def _local_cluster(LocalCluster, n_workers: int | None):
         return LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
                             dashboard_address=":0", silence_logs=logging.CRITICAL)
 
-    held = tuple(getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, name)
-                 and not (name == "SIGHUP" and signal.getsignal(signal.SIGHUP) == signal.SIG_IGN))  # nohup's
+    from hwpts._console import interrupt_signals
+
+    held = interrupt_signals()
     previous = {sig: signal.getsignal(sig) for sig in held}
     if (threading.current_thread() is not threading.main_thread() or not hasattr(signal, "pthread_sigmask")
             or any(handler is None for handler in previous.values())):  # handlers not ours to move

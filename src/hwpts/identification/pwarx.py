@@ -250,7 +250,7 @@ class PWARX(BaseEstimator):
         """One line naming the setting, what it takes and what it got, before any fit (the orders,
         regions and rows are checked where they are used); ``segmenter``: the method's own settings
         too (not for a model search's base, whose method the candidates replace)."""
-        from hwpts.identification.settings import check_bool, check_count, check_number, is_count
+        from hwpts.identification.settings import check_bool, check_count, check_number, check_random_state, is_count
 
         for name in ("constant", "polish", "sparse_partition"):
             check_bool(getattr(self, name), name)
@@ -276,15 +276,7 @@ class PWARX(BaseEstimator):
                         "region_models": "a list of region model kinds (one per region)",
                         "partition_columns": "a column name or a non-empty list of them"}[name]
                 raise ParameterError(f"{name} must be {what} or None, got {value!r}")
-        seed = self.random_state
-        try:  # what numpy's default_rng takes: None, an int >= 0, a SeedSequence, a Generator, ...
-            if isinstance(seed, (bool, np.bool_, str, bytes, float)):
-                raise TypeError
-            np.random.default_rng(seed)
-        except (TypeError, ValueError):
-            shown = seed if isinstance(seed, (bool, str, bytes, float, int)) else type(seed).__name__
-            raise ParameterError(f"random_state must be None, an int >= 0 or a numpy Generator or SeedSequence, "
-                                 f"got {shown!r}") from None
+        check_random_state(self.random_state)
         if segmenter:
             self._segmenter().check_params()  # the method's own settings (segmentation_params)
 
@@ -687,42 +679,32 @@ def frame_sample_time(X) -> float | None:
     durations (:func:`frame_time`), else None: an index with a gap (rows dropped, records joined:
     ``fit(..., breaks=...)`` says where) or jitter gives no sample time, as arrays give none, and
     an unsorted one is refused by the fit."""
+    from hwpts.dataset import uniform_sample_time
+
     time = frame_time(X)
     if time is None or time.size < 2 or np.any(np.diff(time) <= 0):
         return None
     try:
-        return IODataset(time, np.zeros((time.size, 1)), np.zeros(time.size), ("u",), "y").uniform_sample_time()
+        return uniform_sample_time(time)
     except DataError:
         return None
 
 
 def data_sample_time(X, sample_time):
-    """The sample time [s] to keep for a fit on ``X``: an IODataset's (:func:`dataset_sample_time`)
-    or a time-indexed DataFrame's, or ``sample_time`` (refused when it contradicts the data's)."""
-    if isinstance(X, IODataset):
-        return dataset_sample_time(X, sample_time)
+    """The sample time [s] to keep for a fit on ``X``: the step of an IODataset's time or of a
+    time-indexed DataFrame's (:func:`frame_sample_time`), or ``sample_time`` when given and equal
+    to it within 1 % (another one is refused: it replaced the data's, and then the model refused
+    its own training data as sampled at another rate)."""
     from hwpts.identification.settings import is_number
 
-    uniform = frame_sample_time(X)
+    if isinstance(X, IODataset):
+        uniform, what = X.uniform_sample_time("the dataset's time", LIBRARY_REMEDY), "the dataset's time"
+    else:
+        uniform, what = frame_sample_time(X), "the DataFrame's time index"
     if uniform is None or sample_time is None:
         return uniform if sample_time is None else sample_time
     if is_number(sample_time, strict=True) and abs(sample_time - uniform) > 0.01 * uniform:
-        raise ParameterError(f"sample_time {sample_time!r} s differs from the DataFrame's time index, sampled every "
-                             f"{uniform:g} s; expected that or sample_time left out")
-    return sample_time
-
-
-def dataset_sample_time(data, sample_time):
-    """The sample time [s] to keep for a fit on the IODataset ``data``: its time's step, or
-    ``sample_time`` when given and equal to it within 1 % (another one is refused: it replaced the
-    dataset's and then its own data were refused by ``score`` as sampled at another rate)."""
-    from hwpts.identification.settings import is_number
-
-    uniform = data.uniform_sample_time("the dataset's time", LIBRARY_REMEDY)
-    if sample_time is None:
-        return uniform
-    if uniform is not None and is_number(sample_time, strict=True) and abs(sample_time - uniform) > 0.01 * uniform:
-        raise ParameterError(f"sample_time {sample_time!r} s differs from the dataset's time, sampled every "
+        raise ParameterError(f"sample_time {sample_time!r} s differs from {what}, sampled every "
                              f"{uniform:g} s; expected that or sample_time left out")
     return sample_time
 

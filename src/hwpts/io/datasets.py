@@ -140,9 +140,8 @@ def _has_hex(data: bytes, delimiter: str, names: list[str]) -> bool:
 
 
 def column_names(path: str | os.PathLike) -> list[str]:
-    """The names of a table's columns without reading its data where the format allows (a CSV's
-    header row, a Parquet schema; a .mat file is read); ``[]`` when they cannot be read (the
-    reader says why)."""
+    """The names of a CSV's or a Parquet file's columns without reading their data (the header
+    row, the schema); ``[]`` for another format or when they cannot be read (the reader says why)."""
     import csv
     import io
 
@@ -160,8 +159,6 @@ def column_names(path: str | os.PathLike) -> list[str]:
             import pyarrow.parquet as pq
 
             return list(pq.read_schema(p).names)
-        if suffix == ".mat":
-            return list(_read_mat(p))
     except Exception:  # noqa: BLE001 - an unreadable file is said by the reader
         return []
     return []

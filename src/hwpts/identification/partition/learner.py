@@ -108,33 +108,20 @@ class PartitionLearner(BaseEstimator):
 
     def check_params(self) -> None:
         """One line naming a setting that is not what it takes (before any fit)."""
-        from hwpts.identification.settings import check_bool, check_count, check_number
+        from hwpts.identification.settings import check_bool, check_count, check_number, check_random_state
 
         owner = "PartitionLearner: "
-
-        def positive(value, name, allow_none=False):  # > 0, infinity included (no regularisation)
-            if (value is None and allow_none) or (not isinstance(value, bool) and isinstance(
-                    value, (int, float, np.integer, np.floating)) and value > 0):
-                return
-            raise ParameterError(f"{owner}{name} must be a number > 0{' or None' if allow_none else ''}, "
-                                 f"got {value!r}")
-
         check_count(self.refinement_rounds, "refinement_rounds", 0, owner)
-        positive(self.C, "C")
+        check_number(self.C, "C", strict=True, owner=owner, finite=False)  # inf: no regularisation
         check_number(self.ridge, "ridge", owner=owner)
         check_bool(self.sparse, "sparse", owner)
-        if not (not isinstance(self.confidence_margin, bool) and isinstance(
-                self.confidence_margin, (int, float, np.integer, np.floating)) and self.confidence_margin >= 0):
-            raise ParameterError(f"{owner}confidence_margin must be a number >= 0, got {self.confidence_margin!r}")
+        check_number(self.confidence_margin, "confidence_margin", owner=owner, finite=False)
         check_count(self.classifier_rows, "classifier_rows", 100, owner)
         check_number(self.sparse_tol, "sparse_tol", owner=owner)
-        positive(self.trim, "trim", allow_none=True)  # None: no trimming (fit_local_models)
-        positive(self.separable_C, "separable_C", allow_none=True)
-        try:
-            np.random.default_rng(self.random_state)
-        except (TypeError, ValueError):
-            raise ParameterError(f"{owner}random_state must be None, an int >= 0 or a numpy Generator, "
-                                 f"got {self.random_state!r}") from None
+        for name in ("trim", "separable_C"):  # None: no trimming (fit_local_models), no sharpening
+            if getattr(self, name) is not None:
+                check_number(getattr(self, name), name, strict=True, owner=owner, finite=False)
+        check_random_state(self.random_state, owner)
 
     @staticmethod
     def _check_rows(X, y, labels, s):
@@ -153,7 +140,8 @@ class PartitionLearner(BaseEstimator):
         if X.shape[0] == 0 or not (np.all(np.isfinite(X)) and np.all(np.isfinite(y))):
             raise DataError("PartitionLearner: X and y must hold at least one row of finite numbers")
         if raw.dtype.kind not in "iu" and not (raw.dtype.kind in "bf" and np.array_equal(raw, np.round(raw))):
-            raise DataError(f"PartitionLearner: labels must be whole numbers 0 .. {s - 1}, got values of type {raw.dtype}")
+            raise DataError(f"PartitionLearner: labels must be whole numbers 0 .. {s - 1}, got values of type "
+                            f"{raw.dtype}")
         labels = raw.astype(np.int64)
         if labels.min() < 0 or labels.max() >= s:
             raise DataError(f"PartitionLearner: labels must lie in 0 .. {s - 1}, got {labels.min()} .. {labels.max()}")

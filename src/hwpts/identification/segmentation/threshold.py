@@ -355,9 +355,9 @@ class ThresholdSegmenter(Segmenter):
         self.n_grid = n_grid
         self.min_share = min_share
 
-    def check_params(self, owner: str = "threshold: ") -> None:
+    def check_params(self) -> None:
         """``column``, ``n_grid`` and ``min_share`` (see :meth:`Segmenter.check_params`)."""
-        check_split_params(self, owner)
+        check_split_params(self, "threshold: ")
 
     def segment(self, X, y, n_regions, structure, rng, columns=None) -> SegmentationResult:
         """The exact least-squares thresholds on the chosen column (or the best column), as a fixed

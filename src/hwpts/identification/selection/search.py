@@ -664,16 +664,12 @@ class PWARXSearch(BaseEstimator):
 
     @staticmethod
     def _check_orders(estimator, n_inputs: int, owner: str = "PWARXSearch: ") -> None:
-        """The orders ``estimator`` is given (those not ``None``) are what a model takes."""
-        from hwpts.identification.regressors import as_order_tuple
-        from hwpts.identification.settings import is_count
+        """The orders ``estimator`` is given (those not ``None``) are what a model takes: checked
+        as the model's fit checks them (:meth:`RegressorStructure.create`)."""
+        from hwpts.identification.regressors import RegressorStructure
 
         try:
-            if estimator.output_order is not None and not is_count(estimator.output_order, 0):
-                raise ParameterError(f"na (output order) must be an int >= 0, got {estimator.output_order!r}")
-            for name, label in (("input_order", "nb (input order)"), ("input_delay", "nk (input delay)")):
-                if getattr(estimator, name) is not None:
-                    as_order_tuple(getattr(estimator, name), n_inputs, label, 0)
+            RegressorStructure.create(*estimator.given_orders(), n_inputs)
         except ParameterError as error:
             raise ParameterError(f"{owner}{error}") from None
 
