@@ -109,7 +109,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     hook = sys.unraisablehook
     _INTERRUPTED.clear()
     if threading.current_thread() is threading.main_thread():
-        from hwpts._console import interrupt_signals
+        from hwpts._signals import interrupt_signals
 
         for sig in interrupt_signals():
             previous[sig] = signal.signal(sig, _interrupt)

@@ -595,6 +595,8 @@ def test_a_run_under_nohup_outlives_a_closed_terminal(tmp_path):
                             stdout=subprocess.PIPE, text=True, env=env,
                             preexec_fn=lambda: signal.signal(signal.SIGHUP, signal.SIG_IGN))
     time.sleep(1.5)
+    if proc.poll() is not None:
+        pytest.skip("the sweep finished before the signal (a very fast machine)")
     proc.send_signal(signal.SIGHUP)
     _, err = proc.communicate(timeout=300)
     assert proc.returncode == 0 and out.exists(), err

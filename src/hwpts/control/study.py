@@ -196,7 +196,7 @@ def _local_cluster(LocalCluster, n_workers: int | None):
         return LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
                             dashboard_address=":0", silence_logs=logging.CRITICAL)
 
-    from hwpts._console import interrupt_signals
+    from hwpts._signals import interrupt_signals
 
     held = interrupt_signals()
     previous = {sig: signal.getsignal(sig) for sig in held}
