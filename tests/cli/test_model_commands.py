@@ -175,8 +175,20 @@ def test_mat_with_a_variable_of_text_says_so(tmp_path, capsys):
     savemat(path, {"u": "hello", "y": np.arange(40.0)})
     out = tmp_path / "m.json"
     _expect_error(capsys, ["identify", str(path), "--input", "u", "--output", "y", "--na", "1", "--nb", "1",
-                           "--out", str(out)], "the variable(s) ['u'] hold no numbers (text, a cell array or a struct)",
+                           "--out", str(out)], "the variable 'u' holds no numbers (text, a cell array or a struct)",
                   out)
+
+
+@pytest.mark.parametrize("value, said", [(np.eye(3), "is a square 3x3 matrix (its samples could run down or across)"),
+                                         (np.zeros((0, 0)), "is empty (0x0)"),
+                                         (np.zeros((40, 2, 2)), "is a 3-D array (40x2x2)")])
+def test_mat_variable_that_is_no_vector_says_what_it_is(tmp_path, capsys, value, said):
+    """A square, empty or 3-D output variable was said to be missing although the file has it."""
+    path = tmp_path / "d.mat"
+    savemat(path, {"u": np.arange(40.0), "y": value})
+    out = tmp_path / "m.json"
+    _expect_error(capsys, ["identify", str(path), "--input", "u", "--output", "y", "--na", "1", "--nb", "1",
+                           "--out", str(out)], f"the variable 'y' {said}; save each signal as a numeric vector", out)
 
 
 def test_mat_with_the_variables_works(tmp_path, capsys):

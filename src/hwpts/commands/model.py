@@ -140,12 +140,13 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
         raise DataError(f"{str(path)!r}: no time column {time_name!r}; {_available(path, columns)}")
     missing = [c for c in signals if c not in columns]
     if missing:
-        from hwpts.io.datasets import mat_non_numeric
+        from hwpts.io.datasets import mat_unread
 
-        other = [c for c in missing if c in mat_non_numeric(path)]
-        if other:  # there, but not numbers
-            raise DataError(f"{str(path)!r}: the variable(s) {other} hold no numbers (text, a cell array or a "
-                            f"struct); save each signal as a numeric vector; {_available(path, columns)}")
+        unread = mat_unread(path)
+        if any(c in unread for c in missing):  # there, but not a signal
+            c = next(c for c in missing if c in unread)
+            raise DataError(f"{str(path)!r}: the variable {c!r} {unread[c]}; save each signal as a numeric "
+                            f"vector; {_available(path, columns)}")
         raise DataError(f"{str(path)!r}: no column(s) {missing}; {_available(path, columns)}")
     sl = _rows(rows)
     total = len(columns[output_name])

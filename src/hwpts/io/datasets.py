@@ -455,17 +455,38 @@ def _loadmat_isolated(p: Path) -> dict:
                 for i, (name, kind) in enumerate(zip(meta["names"], meta["kinds"]))}
 
 
-def mat_non_numeric(path: str | os.PathLike) -> list[str]:
-    """The variables of a .mat file that are not read as columns because they hold no numbers
-    (text, cells, structs); ``[]`` for another format or an unreadable file."""
+def mat_unread(path: str | os.PathLike) -> dict[str, str]:
+    """The variables of a .mat file that are not read as columns, each with why (text, cells and
+    structs; empty, square and 3-D arrays); ``{}`` for another format or an unreadable file."""
     p = Path(path)
     if p.suffix.lower() != ".mat":
-        return []
+        return {}
     try:
         raw = _loadmat_isolated(p)
     except DataError:
-        return []
-    return sorted(name for name, value in raw.items() if not name.startswith("__") and value is None)
+        return {}
+    reasons = {name: _mat_unread_reason(value) for name, value in raw.items() if not name.startswith("__")}
+    return {name: reason for name, reason in reasons.items() if reason is not None}
+
+
+def _mat_unread_reason(value) -> str | None:
+    """Why a .mat variable (as :func:`_loadmat_isolated` gives it) is not read as columns, or
+    ``None`` when it is (sparse and complex variables are refused, not skipped: ``None`` too)."""
+    if value is None:
+        return "holds no numbers (text, a cell array or a struct)"
+    if isinstance(value, str):
+        return None
+    arr = np.asarray(value)
+    if arr.dtype.kind not in "biuf":
+        return None if arr.dtype.kind == "c" else "holds no numbers"
+    shape = "x".join(map(str, arr.shape))
+    if arr.size == 0:
+        return f"is empty ({shape})"
+    if arr.ndim > 2:
+        return f"is a {arr.ndim}-D array ({shape})"
+    if arr.ndim == 2 and 1 not in arr.shape and arr.shape[0] == arr.shape[1]:
+        return f"is a square {shape} matrix (its samples could run down or across)"
+    return None
 
 
 def _read_mat(p: Path) -> dict[str, np.ndarray]:
@@ -480,22 +501,18 @@ def _read_mat(p: Path) -> dict[str, np.ndarray]:
     for name, value in raw.items():
         if name.startswith("__"):
             continue
-        if value is None:
-            continue
         if isinstance(value, str):  # "sparse"
             raise DataError(f"{str(p)!r}: variable {name!r} is a sparse matrix; save it as a full (dense) array")
         arr = np.asarray(value)
         if arr.dtype.kind == "c":
             raise DataError(f"{str(p)!r}: variable {name!r} is complex; hwpts models real signals "
                             f"(save the real part, or the magnitude, as its own variable)")
-        if arr.dtype.kind not in "biuf" or arr.size == 0:
+        if _mat_unread_reason(arr) is not None:  # text, empty, square (samples down or across?), 3-D
             continue
         arr = arr.astype(float)
         if arr.ndim == 2 and 1 in arr.shape:
             out[name] = arr.reshape(-1)
         elif arr.ndim == 2:
-            if arr.shape[0] == arr.shape[1]:  # samples down or across: nothing tells which, so not read
-                continue
             if arr.shape[0] < arr.shape[1]:  # the longer side is the samples
                 arr = arr.T
             for j in range(arr.shape[1]):
