@@ -118,6 +118,36 @@ def test_blocked_selection_covers_the_record_and_parallel_matches_sequential():
         PWARXSearch(PWARX(), []).fit(u, y)
 
 
+def test_a_search_in_worker_processes_races_as_one_in_this_process():
+    """n_jobs changed the choice: in worker processes no candidate was pruned, so a search there
+    tried candidates the race in this process had stopped (the hydraulic actuator: another model,
+    55 rows against 69). The workers now score every block and the race is replayed on those
+    scores: the same table, row for row (times aside), and the same choice."""
+    import json
+
+    u, y = setar(600, 1)
+    tables, chosen = [], []
+    for n_jobs in (None, 2):
+        search = PWARXSearch(PWARX(random_state=0), orders="auto", n_jobs=n_jobs).fit(u, y)
+        tables.append(json.dumps([{k: v for k, v in r.items() if k != "fit_time_s"} for r in search.cv_results_],
+                                 default=str))
+        chosen.append(search.best_params_)
+    assert sum(r["pruned"] for r in search.cv_results_) > 0  # the race stopped some candidates
+    assert tables[0] == tables[1] and chosen[0] == chosen[1]
+
+
+def test_the_replayed_race_cuts_a_row_where_the_race_stops():
+    from hwpts.identification.selection.search import PRUNE_MARGIN, _replay_race, _row
+
+    full = _row({"n_regions": 2}, [80.0, 60.0, 90.0], [99.0, 98.0, 99.0], [2, 2, 2], None, None, 0.1)
+    assert _replay_race({**full, "_blocks": ([80.0, 60.0, 90.0], [99.0, 98.0, 99.0], [2, 2, 2])}, 3) == full
+    cut = _replay_race({**full, "_blocks": ([80.0, 60.0, 90.0], [99.0, 98.0, 99.0], [2, 2, 2])}, 3,
+                       prune_below=70.0 + PRUNE_MARGIN + 0.5)
+    assert cut["pruned"] and cut["split_fits_percent"] == [80.0, 60.0] and cut["mean_fit_percent"] is None
+    gone = _replay_race({**full, "_blocks": ([80.0, float("nan")], [99.0, -50.0], [2, 2])}, 3)
+    assert gone["diverged"] and gone["split_fits_percent"][0] == 80.0
+
+
 def test_blocked_split_drops_the_regressor_rows_spanning_the_gap():
     """The training part of an inner block joins two stretches: the search passes the break, and
     the fit drops the max_lag regressor rows that mix samples from both sides."""

@@ -246,20 +246,34 @@ def _same_blocks(row, j, one_step, fallback) -> float:
     return float(np.mean(row["split_one_step_fits_percent" if one_step else "split_fits_percent"][:j]))
 
 
+def _race_stop(fits, ones, n_splits, prune_below=-np.inf, leader=None, one_step=False, best_row=None):
+    """Why a candidate scored on the blocks so far (free-run ``fits``, one-step ``ones``) is not
+    scored on the rest: ``"diverged"`` (its last free run), ``"pruned"`` (:func:`_evaluate`'s race),
+    or ``None``."""
+    if not np.isfinite(fits[-1]):
+        return "diverged"
+    if len(fits) >= n_splits:
+        return None
+    running = np.mean(ones if one_step else fits)
+    if running < _same_blocks(best_row, len(fits), one_step, prune_below) - PRUNE_MARGIN or _trails(fits, ones, leader):
+        return "pruned"
+    return None
+
+
 def _evaluate(estimator, params, u, y, splits, prune_below=-np.inf, names=None, output_name=None, leader=None,
-              one_step=False, best_row=None):
+              one_step=False, best_row=None, keep_blocks=False):
     """One table row: the candidate's block fits, mean, or why it failed. A candidate whose running
     mean (of the one-step fits when ``one_step``, else of the free-run fits) falls ``PRUNE_MARGIN``
     points below the best complete candidate's mean over the same blocks (``best_row``; its mean
     ``prune_below`` over all blocks when no row is given; no race when ``prune_below`` is -inf), or
     whose first blocks trail the ``leader`` row's same blocks (:func:`_trails`), is not scored on
     its remaining blocks (``pruned``; ranked after the complete ones). The blocks differ in
-    difficulty (module doc), so a running mean is only compared with the same blocks' mean."""
-    row = {"params": params, "split_fits_percent": None, "mean_fit_percent": None, "diverged": False,
-           "pruned": False, "error": None, "n_regions_fitted": None, "fit_time_s": None,
-           "mean_one_step_fit_percent": None, "split_one_step_fits_percent": None}
+    difficulty (module doc), so a running mean is only compared with the same blocks' mean.
+    ``keep_blocks``: the blocks scored before a failure are kept too (``"_blocks"``, for
+    :func:`_replay_race`)."""
     t0 = time.perf_counter()
     fits, regions, ones = [], [], []
+    stop = error = None
     try:
         model = _candidate(estimator, params)
         for train, test in splits:
@@ -267,26 +281,44 @@ def _evaluate(estimator, params, u, y, splits, prune_below=-np.inf, names=None, 
             fits.append(fit)
             ones.append(one)
             regions.append(s)
-            if not np.isfinite(fit):
-                row["diverged"] = True
+            stop = _race_stop(fits, ones, len(splits), prune_below, leader, one_step, best_row)
+            if stop is not None:
                 break
-            running = np.mean(ones if one_step else fits)
-            if len(fits) < len(splits) and (running < _same_blocks(best_row, len(fits), one_step, prune_below)
-                                            - PRUNE_MARGIN or _trails(fits, ones, leader)):
-                row["pruned"] = True
-                break
-    except HwptsError as error:
-        row["error"] = str(error)
-    except np.linalg.LinAlgError as error:
-        row["error"] = f"singular least squares ({error})"
-    row["fit_time_s"] = round(time.perf_counter() - t0, 4)
-    if row["error"] is None:
+    except HwptsError as exc:
+        error = str(exc)
+    except np.linalg.LinAlgError as exc:
+        error = f"singular least squares ({exc})"
+    row = _row(params, fits, ones, regions, stop, error, time.perf_counter() - t0)
+    if keep_blocks:
+        row["_blocks"] = (fits, ones, regions)
+    return row
+
+
+def _row(params, fits, ones, regions, stop, error, elapsed) -> dict:
+    """A ``cv_results_`` row of a candidate's block fits, how its scoring stopped and its time."""
+    row = {"params": params, "split_fits_percent": None, "mean_fit_percent": None, "diverged": stop == "diverged",
+           "pruned": stop == "pruned", "error": error, "n_regions_fitted": None, "fit_time_s": round(elapsed, 4),
+           "mean_one_step_fit_percent": None, "split_one_step_fits_percent": None}
+    if error is None:
         row["split_fits_percent"] = [round(float(f), 3) for f in fits]
         row["split_one_step_fits_percent"] = [round(float(f), 3) for f in ones]
         row["n_regions_fitted"] = int(max(regions)) if regions else None
-        if not row["diverged"] and not row["pruned"]:
+        if stop is None:
             row["mean_fit_percent"] = float(np.mean(fits))
             row["mean_one_step_fit_percent"] = float(np.mean(ones))
+    return row
+
+
+def _replay_race(row, n_splits, prune_below=-np.inf, leader=None, one_step=False, best_row=None) -> dict:
+    """The row :func:`_evaluate` would have made in the race of the given arguments, from ``row``
+    scored without a race (``keep_blocks``): the same blocks, cut where the race stops. A search in
+    worker processes scores every candidate on every block, then replays the race in the order of
+    the candidates, so ``n_jobs`` does not change the table's scores nor the choice."""
+    fits, ones, regions = row.pop("_blocks")
+    for j in range(1, len(fits) + 1):
+        stop = _race_stop(fits[:j], ones[:j], n_splits, prune_below, leader, one_step, best_row)
+        if stop is not None:
+            return _row(row["params"], fits[:j], ones[:j], regions[:j], stop, None, row["fit_time_s"])
     return row
 
 
@@ -360,7 +392,10 @@ class PWARXSearch(BaseEstimator):
         autoregressive part (without one the free run is the one-step prediction, which least
         squares already minimises).
     n_jobs : int or None
-        Processes for the candidates (joblib); ``None`` runs them in this process.
+        Processes for the candidates (joblib); ``None`` runs them in this process. The table and
+        the choice are the same either way: in processes every candidate is scored on every block
+        and the race replayed on those scores, so on a machine of few cores the search in this
+        process, which skips the blocks the race stops, is often the faster.
     progress : bool
         A progress bar on a terminal.
     shared_modes : {"auto", True, False}
@@ -546,33 +581,36 @@ class PWARXSearch(BaseEstimator):
         return splits
 
     def _run(self, base, candidates, u, y, splits, stage, bar, best=-np.inf, leader=None, floor=-np.inf):
-        """Rows of ``candidates``; in this process a candidate is raced (once ``best``, the best
-        mean so far, reaches ``floor``) against the same blocks of the row that holds ``best``
-        (``leader`` where it does, then the best row of this run) and, when a ``leader`` row is
-        given, against the leader's blocks (:func:`_trails`); in worker processes every candidate
-        is scored on every block."""
+        """Rows of ``candidates``; a candidate is raced (once ``best``, the best mean so far,
+        reaches ``floor``) against the same blocks of the row that holds ``best`` (``leader`` where
+        it does, then the best row of this run) and, when a ``leader`` row is given, against the
+        leader's blocks (:func:`_trails`). In worker processes (``n_jobs``) every candidate is
+        scored on every block and the race replayed on those scores (:func:`_replay_race`): the
+        same table and choice as in this process, at the price of the blocks the race skips."""
         from joblib import Parallel, delayed
 
         names, oname = self._names
         one_step = self.scoring_ == "one_step"
-        if self.n_jobs in (None, 1):
-            rows = []
-            best_row = leader if leader is not None and self._score(leader) >= best else None
-            for params in candidates:
-                rows.append(_evaluate(base, params, u, y, splits, best if best >= floor else -np.inf, names, oname,
-                                      leader, one_step, best_row=best_row))
-                if self._score(rows[-1]) > best:
-                    best, best_row = self._score(rows[-1]), rows[-1]
-                if leader is not None and self._score(rows[-1]) > self._score(leader):
-                    leader = rows[-1]
-                if bar is not None:
-                    bar.update(1)
-        else:
-            rows = Parallel(n_jobs=self.n_jobs)(delayed(_evaluate)(base, p, u, y, splits, -np.inf, names, oname,
-                                                                   None, one_step)
-                                                for p in candidates)
+        scored = None
+        if self.n_jobs not in (None, 1):  # every block scored in the workers, the race replayed below
+            scored = Parallel(n_jobs=self.n_jobs)(delayed(_evaluate)(base, p, u, y, splits, -np.inf, names, oname,
+                                                                     None, one_step, keep_blocks=True)
+                                                  for p in candidates)
+        rows = []
+        best_row = leader if leader is not None and self._score(leader) >= best else None
+        for i, params in enumerate(candidates):
+            race = (best if best >= floor else -np.inf, leader, one_step, best_row)
+            if scored is None:
+                rows.append(_evaluate(base, params, u, y, splits, race[0], names, oname, leader, one_step,
+                                      best_row=best_row))
+            else:
+                rows.append(_replay_race(scored[i], len(splits), *race))
+            if self._score(rows[-1]) > best:
+                best, best_row = self._score(rows[-1]), rows[-1]
+            if leader is not None and self._score(rows[-1]) > self._score(leader):
+                leader = rows[-1]
             if bar is not None:
-                bar.update(len(candidates))
+                bar.update(1)
         for row in rows:
             row["stage"] = stage
         return rows
