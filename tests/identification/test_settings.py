@@ -430,10 +430,22 @@ def test_a_time_indexed_frame_gives_its_sample_time_and_data_at_another_rate_are
         model.score(pd.DataFrame({"u": u[:, 0]}, index=fast), pd.Series(y, index=fast))
     with pytest.raises(ParameterError, match="sample_time 0.5 s differs from the DataFrame's time index"):
         PWARX(1, 1, 1).fit(frame, output, sample_time=0.5)
-    # an index with a gap gives no sample time (the gap is the fit's breaks to say), as arrays
+    # an index with a gap was fitted as one record, its lags across the gap (as an IODataset's
+    # time it is refused): refused unless the fit's breaks say where the record restarts; then
+    # the stretches give the sample time
     gap = index[:-1].append(pd.DatetimeIndex([index[-1] + pd.Timedelta("4s")]))
+    with pytest.raises(DataError, match=r"not uniformly sampled \(step 0.01 s, but 4.01 s at row 599\).*breaks"):
+        PWARX(1, 1, 1, segmentation="threshold").fit(pd.DataFrame({"u": u[:, 0]}, index=gap), y)
     gapped = PWARX(1, 1, 1, segmentation="threshold").fit(pd.DataFrame({"u": u[:, 0]}, index=gap), y, breaks=[599])
-    assert gapped.sample_time_ is None
-    assert np.isfinite(gapped.score(pd.DataFrame({"u": u[:, 0]}, index=gap), y))
-    assert np.isfinite(model.score(pd.DataFrame({"u": u[:, 0]}, index=gap), y))
+    assert gapped.sample_time_ == 0.01
+    with pytest.raises(DataError, match=r"not uniformly sampled .*: resample it \(X.resample"):
+        model.score(pd.DataFrame({"u": u[:, 0]}, index=gap), y)
+    with pytest.raises(DataError, match="not uniformly sampled .*search each stretch on its own"):
+        PWARXSearch(PWARX(1, 1, 1)).fit(pd.DataFrame({"u": u[:, 0]}, index=gap), y)
+    twice = index[:300].append(index[299:-1])  # a repeated time stamp: two samples of one instant
+    with pytest.raises(DataError, match="repeats a time stamp at row 300"):
+        PWARX(1, 1, 1).fit(pd.DataFrame({"u": u[:, 0]}, index=twice), y)
+    slower = index[:300].append(pd.date_range(index[299] + pd.Timedelta("1s"), periods=300, freq="20ms"))
+    with pytest.raises(DataError, match="steps 0.01 s, but 0.02 s from row 300"):
+        PWARX(1, 1, 1).fit(pd.DataFrame({"u": u[:, 0]}, index=slower), y, breaks=[300])
     assert model.score(u, y) == model.score(frame, output)  # arrays carry no rate to check

@@ -306,9 +306,10 @@ class PWARX(BaseEstimator):
         """Identify the model from inputs ``X`` (n, n_inputs) and output ``y`` (n,), or an IODataset.
 
         ``X`` may be a pandas DataFrame: its column names become the input names, and later
-        predictions select the columns by name (in any order); indexed by uniformly spaced time
-        stamps or durations, its step is the sample time (a time index at another rate is refused
-        later; one with a gap gives none).
+        predictions select the columns by name (in any order); indexed by time stamps or
+        durations, its step is the sample time (a time index at another rate is refused later; one
+        with a gap, jitter or a repeated stamp is refused, unless ``breaks`` say where the record
+        restarts).
         ``y`` may have shape (n, 1).
         ``input_names`` (one per input) and ``output_name`` name plain arrays' signals (default
         ``u1, u2, ...`` and ``y``, or a named Series' name); an IODataset names its own.
@@ -318,16 +319,16 @@ class PWARX(BaseEstimator):
         given); kept in the model so that data at another rate are refused. ``units``: optional
         ``{signal name: unit}`` kept for plots and exports. Returns ``self``.
         """
-        sample_time = data_sample_time(X, sample_time)  # an IODataset's or a time-indexed DataFrame's
         check_fit_arguments(sample_time, units, output_name)
         self._check_settings()
         u, yy, names, oname = self._signals(X, y, input_names, output_name)
+        breaks = _check_breaks(breaks, yy.shape[0])
+        sample_time = data_sample_time(X, sample_time, breaks)  # an IODataset's or a time-indexed DataFrame's
         n_inputs = u.shape[1]
         names = tuple(names) if names is not None else default_input_names(n_inputs)
         if oname is None:  # the output unnamed: "y", unless an input has that name
             oname = "y" if "y" not in names else "y_out"
         _check_names(names, oname, n_inputs)
-        breaks = _check_breaks(breaks, yy.shape[0])
         structure = RegressorStructure.create(*self.given_orders(), n_inputs, self.constant, names, oname,
                                               self.output_powers, *power_scaling(yy))
         structure.check_length(yy.shape[0])
@@ -455,7 +456,7 @@ class PWARX(BaseEstimator):
         else:
             _check_index(X, y)
             known = getattr(self, "sample_time_", None)
-            dt = frame_sample_time(X)
+            dt = frame_sample_time(X, remedy="resample it (X.resample(...))")
             if known is not None and dt is not None and abs(dt - known) > 0.01 * known:
                 raise DataError(f"the DataFrame's time index is sampled every {dt:.6g} s, the model every "
                                 f"{known:.6g} s: its lags would mean other delays; resample the data or refit")
@@ -674,33 +675,59 @@ def frame_time(X) -> np.ndarray | None:
     return values.astype("timedelta64[ns]").astype(np.int64) / 1e9
 
 
-def frame_sample_time(X) -> float | None:
-    """The sample period [s] of a pandas object indexed by uniformly spaced time stamps or
-    durations (:func:`frame_time`), else None: an index with a gap (rows dropped, records joined:
-    ``fit(..., breaks=...)`` says where) or jitter gives no sample time, as arrays give none, and
-    an unsorted one is refused by the fit."""
+FRAME_REMEDY = "resample it (X.resample(...)), or give fit(..., breaks=[...]) the rows where each stretch starts"
+
+
+def frame_sample_time(X, breaks=(), remedy: str = FRAME_REMEDY) -> float | None:
+    """The sample period [s] of a pandas object indexed by time stamps, periods or durations
+    (:func:`frame_time`), else None (no time index, or fewer than two rows). An index that repeats
+    a time stamp, or is not uniform (a gap: rows dropped, records joined; or jitter) is refused as
+    an IODataset's time is: read by position, the lags would span the gap. With ``breaks`` (the
+    rows where the record restarts) only the steps within each stretch must be uniform, and agree.
+    An unsorted index is refused before (:func:`_check_index`)."""
     from hwpts.dataset import uniform_sample_time
 
     time = frame_time(X)
-    if time is None or time.size < 2 or np.any(np.diff(time) <= 0):
+    if time is None or time.size < 2:
         return None
-    try:
-        return uniform_sample_time(time)
-    except DataError:
+    repeated = np.flatnonzero(np.diff(time) == 0)
+    if repeated.size:
+        raise DataError(f"the DataFrame's time index repeats a time stamp at row {int(repeated[0]) + 1} (two "
+                        f"samples of one instant): drop or average the duplicates (X[~X.index.duplicated()])")
+    edges = [0, *sorted(int(b) for b in breaks or ()), time.size]
+    found = []
+    for a, b in zip(edges[:-1], edges[1:]):
+        try:
+            dt = uniform_sample_time(time[a:b], "the DataFrame's time index", remedy)
+        except DataError as error:
+            if a == 0:
+                raise
+            raise DataError(f"{error} (in the stretch from row {a})") from None
+        if dt is not None:
+            found.append((dt, a))
+    if not found:
         return None
+    dt, _ = found[0]
+    other = next(((d, a) for d, a in found if abs(d - dt) > 0.01 * dt), None)
+    if other is not None:
+        raise DataError(f"the DataFrame's time index steps {dt:.6g} s, but {other[0]:.6g} s from row {other[1]}: "
+                        f"PWARX models need one sample time; resample the stretches to one rate")
+    return dt
 
 
-def data_sample_time(X, sample_time):
+def data_sample_time(X, sample_time, breaks=(), remedy: str | None = None):
     """The sample time [s] to keep for a fit on ``X``: the step of an IODataset's time or of a
-    time-indexed DataFrame's (:func:`frame_sample_time`), or ``sample_time`` when given and equal
-    to it within 1 % (another one is refused: it replaced the data's, and then the model refused
-    its own training data as sampled at another rate)."""
+    time-indexed DataFrame's (:func:`frame_sample_time`, with the fit's ``breaks``), or
+    ``sample_time`` when given and equal to it within 1 % (another one is refused: it replaced the
+    data's, and then the model refused its own training data as sampled at another rate).
+    ``remedy``: what a message on a non-uniform time says to do (default: resample or give breaks)."""
     from hwpts.identification.settings import is_number
 
     if isinstance(X, IODataset):
-        uniform, what = X.uniform_sample_time("the dataset's time", LIBRARY_REMEDY), "the dataset's time"
+        uniform = X.uniform_sample_time("the dataset's time", remedy or LIBRARY_REMEDY)
+        what = "the dataset's time"
     else:
-        uniform, what = frame_sample_time(X), "the DataFrame's time index"
+        uniform, what = frame_sample_time(X, breaks, remedy or FRAME_REMEDY), "the DataFrame's time index"
     if uniform is None or sample_time is None:
         return uniform if sample_time is None else sample_time
     if is_number(sample_time, strict=True) and abs(sample_time - uniform) > 0.01 * uniform:

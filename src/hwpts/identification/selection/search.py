@@ -633,7 +633,8 @@ class PWARXSearch(BaseEstimator):
         """
         from hwpts.identification.pwarx import data_sample_time
 
-        sample_time = data_sample_time(X, sample_time)  # an IODataset's or a time-indexed DataFrame's
+        # an IODataset's or a time-indexed DataFrame's (the search takes no breaks)
+        sample_time = data_sample_time(X, sample_time, remedy="resample it, or search each stretch on its own")
         from hwpts.identification.pwarx import check_fit_arguments
 
         check_fit_arguments(sample_time, units, output_name)
