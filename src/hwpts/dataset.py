@@ -16,6 +16,30 @@ from hwpts.errors import DataError
 MAX_ABS_VALUE = 1e100  # largest magnitude of a signal value (its squares, and sums of them, stay finite)
 
 
+def dense_real(values, label: str) -> np.ndarray:
+    """``values`` as a float array; sparse, complex or non-numeric input is refused (a cast would
+    drop the imaginary part or fail without saying which argument)."""
+    if hasattr(values, "tocsr") or hasattr(values, "toarray"):
+        raise DataError(f"{label} is a sparse matrix; pass a dense array ({label}.toarray())")
+    arr = np.asarray(values)
+    if np.iscomplexobj(arr):
+        raise DataError(f"{label} is complex; hwpts models real signals (pass the real part or the magnitude)")
+    if arr.dtype.kind in "mM":  # numpy casts dates to nanosecond counts without a word
+        raise DataError(f"{label} holds dates or durations ({arr.dtype}); hwpts models numeric signals (pass the "
+                        f"time as the dataset's time axis, not as a signal)")
+    if arr.dtype.kind in "US" or (arr.dtype.kind == "O" and any(isinstance(v, (str, bytes)) for v in arr.flat)):
+        # as scikit-learn: text is not read as numbers, even where it could be (a DataFrame column
+        # of strings, an object array, a numpy array of text alike)
+        raise DataError(f"{label} holds text ({arr.dtype}); convert it to numbers first "
+                        f"({label}.astype(float) where every entry is one)")
+    if arr.dtype.kind not in "biuf":
+        try:
+            arr = arr.astype(float)
+        except (TypeError, ValueError):
+            raise DataError(f"{label} must hold numbers, got values of type {arr.dtype}") from None
+    return np.asarray(arr, dtype=float)
+
+
 @dataclass(frozen=True)
 class IODataset:
     """Sampled multi-input single-output data.
@@ -44,9 +68,13 @@ class IODataset:
     extra: dict = field(default_factory=dict)
 
     def __post_init__(self):
-        time = np.asarray(self.time, dtype=float)
-        inputs = np.asarray(self.inputs, dtype=float)
-        output = np.asarray(self.output, dtype=float)
+        time = np.asarray(self.time)
+        if time.dtype.kind in "mM" and time.ndim == 1:  # time stamps or durations: seconds from the first
+            start = time[0] if time.size and time.dtype.kind == "M" else np.timedelta64(0, "ns")
+            time = (time - start).astype("timedelta64[ns]").astype(np.int64) / 1e9
+        time = dense_real(time, "time")  # complex or text refused, not cast
+        inputs = dense_real(self.inputs, "inputs")
+        output = dense_real(self.output, "output")
         if inputs.ndim == 1:
             inputs = inputs[:, None]
         names = tuple(str(n) for n in self.input_names)
@@ -76,7 +104,7 @@ class IODataset:
         if n > 1 and not np.all(np.diff(time) > 0):
             bad = int(np.argmax(~(np.diff(time) > 0))) + 1
             raise DataError(f"time must be strictly increasing; it is not at row {bad}")
-        extra = {str(k): np.asarray(v, dtype=float) for k, v in dict(self.extra).items()}
+        extra = {str(k): dense_real(v, f"extra column {str(k)!r}") for k, v in dict(self.extra).items()}
         for key, values in extra.items():
             if values.shape != (n,):
                 raise DataError(f"extra column {key!r} has shape {values.shape}, expected ({n},)")

@@ -547,3 +547,40 @@ def test_polish_is_one_trust_region_descent_that_never_raises_the_training_error
             assert info["final_sse"] < info["initial_sse"]
         else:
             np.testing.assert_array_equal(theta, model.theta_)
+
+
+def test_complex_data_and_scores_are_refused_and_a_dataset_takes_time_stamps():
+    """IODataset kept the real part of a complex output (numpy's ComplexWarning only) and
+    SimulationResult.score too; an (n, 2) measured output was scored as 2n samples."""
+    from hwpts.dataset import IODataset
+
+    rng = np.random.default_rng(0)
+    u = rng.uniform(-1, 1, 400)
+    y = np.cumsum(u) * 0.1 + 0.01 * rng.standard_normal(400)
+    with pytest.raises(DataError, match="output is complex"):
+        IODataset(np.arange(400) * 0.01, u, y + 1j * y, ("u",), "y")
+    stamps = np.datetime64("2026-01-01T00:00:00") + np.arange(400) * np.timedelta64(10, "ms")
+    assert IODataset(stamps, u, y, ("u",), "y").uniform_sample_time() == 0.01
+    run = PWARX(1, 1, 1).fit(u, y).simulate(u, y)
+    with pytest.raises(DataError, match="measured is complex"):
+        run.score(y + 0j)
+    with pytest.raises(DataError, match=r"measured must be the output, shape \(n,\) or \(n, 1\); got shape \(400, 2\)"):
+        run.score(np.c_[y, y])
+    assert run.score(y[:, None]) == run.score(y)
+
+
+def test_a_signal_too_small_to_fit_is_refused():
+    """Inputs of 1e-170 gave zero gains with an 'ill-conditioned' warning only (values above 1e100
+    were refused); 1e-90 fits as at 1."""
+    rng = np.random.default_rng(0)
+    u = rng.uniform(-1, 1, 400)
+    y = np.zeros(400)
+    for k in range(1, 400):
+        y[k] = 0.5 * y[k - 1] + u[k - 1] + 0.01 * rng.standard_normal()
+    with pytest.raises(DataError, match="signal 'u1' holds no value larger than 9.99e-171 in magnitude, below 1e-100"):
+        PWARX(1, 1, 1).fit(u * 1e-170, y)
+    with pytest.raises(DataError, match="signal 'y' holds no value larger than"):
+        PWARX(1, 1, 1).fit(u, y * 1e-120)
+    small = PWARX(1, 1, 1, n_regions=1, segmentation="average").fit(u * 1e-90, y)
+    assert small.score(u * 1e-90, y) == pytest.approx(
+        PWARX(1, 1, 1, n_regions=1, segmentation="average").fit(u, y).score(u, y), abs=1e-9)

@@ -439,3 +439,43 @@ def test_threshold_alternating_names_itself_in_its_errors():
     with pytest.raises(ParameterError, match=r"^threshold-alternating: max_iter"):
         PWARX(1, 1, 1, n_regions=3, segmentation="threshold-alternating",
               segmentation_params={"max_iter": 0}).fit(u, y)
+
+
+@pytest.mark.parametrize("name", sorted(SEGMENTATION_METHODS))
+def test_segment_checks_its_rows_and_seeds_from_an_int(name):
+    """Called directly, a segmenter took 350 targets for 400 rows (zscore returned 350 labels) and
+    an int or None for the Generator failed deep inside ('int' object has no attribute 'integers')."""
+    from hwpts.errors import DataError
+
+    rng = np.random.default_rng(0)
+    u = rng.uniform(-1, 1, 400)
+    y = np.where(u > 0, 0.8 * u, -0.5 * u) + 0.01 * rng.standard_normal(400)
+    structure = RegressorStructure.create(0, 1, 0, 1)
+    X, t = structure.build(u[:, None], y)
+    kwargs = {"hyperplanes": ["1,0"]} if name == "hyperplane" else {}
+    segmenter = make_segmenter(name, **kwargs)
+    with pytest.raises(DataError, match=r"y must be the targets of X's 400 rows, shape \(400,\); got shape \(350,\)"):
+        segmenter.segment(X, t[:350], 2, structure, np.random.default_rng(0))
+    bad = X.copy()
+    bad[7, 0] = np.nan
+    with pytest.raises(DataError, match="X has a non-finite value .* at row 7"):
+        segmenter.segment(bad, t, 2, structure, np.random.default_rng(0))
+    with pytest.raises(ParameterError, match="rng must be a numpy Generator, an int >= 0 or None, got 'a'"):
+        segmenter.segment(X, t, 2, structure, "a")
+    seeded = segmenter.segment(X, t, 2, structure, 3)
+    np.testing.assert_array_equal(seeded.labels, segmenter.segment(X, t, 2, structure, np.random.default_rng(3)).labels)
+    assert segmenter.segment(X, t, 2, structure, None).labels.shape == (400,)
+
+
+def test_the_partition_learner_refuses_columns_it_has_not():
+    """columns=[-1] read the last column and dropped a region without a word; [5] and ['u1'] raised
+    numpy's IndexError and ValueError, [] scikit-learn's."""
+    from hwpts.identification.partition import PartitionLearner
+
+    rng = np.random.default_rng(0)
+    X = rng.standard_normal((300, 2))
+    labels = (X[:, 0] > 0).astype(int)
+    for columns in ([-1], [5], ["u1"], [], [0, 0]):
+        with pytest.raises(ParameterError, match="columns must be distinct indices of X's columns 0 .. 1"):
+            PartitionLearner().learn(X, X[:, 0], labels, 2, columns=columns)
+    assert np.array_equal(PartitionLearner().learn(X, X[:, 0], labels, 2, columns=np.array([0]))[0], labels)

@@ -57,7 +57,9 @@ def fit_percent(y, yhat) -> float:
     if not np.all(np.isfinite(yhat)):
         return float("nan")
     scale = max(float(np.max(np.abs(y))), float(np.max(np.abs(yhat))))
-    if scale > 1e150:  # the norms' squares would overflow (a 1e160 signal scored nan): scale both first
+    if scale > 1e150 or 0 < scale < 1e-100:
+        # the norms' squares would overflow (a 1e160 signal scored nan) or lose their digits in
+        # subnormal numbers (a 1e-160 signal scored 89.995 % for 89.986 %): scale both first
         y, yhat = y / scale, yhat / scale
     den = np.linalg.norm(y - y.mean())
     if den == 0:

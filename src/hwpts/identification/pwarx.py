@@ -332,6 +332,11 @@ class PWARX(BaseEstimator):
         structure = RegressorStructure.create(*self.given_orders(), n_inputs, self.constant, names, oname,
                                               self.output_powers, *power_scaling(yy))
         structure.check_length(yy.shape[0])
+        for name, values in [*zip(names, u.T), (structure.output_name, yy)]:
+            largest = float(np.max(np.abs(values)))
+            if 0 < largest < MIN_ABS_SCALE:  # its least squares gave zero gains, with a warning only
+                raise DataError(f"signal {name!r} holds no value larger than {largest:.3g} in magnitude, below "
+                                f"{MIN_ABS_SCALE:.0e}: too small to fit; rescale it")
         for j, name in enumerate(names):
             if structure.nb[j] > 0 and np.ptp(u[:, j]) == 0:
                 raise DataError(
@@ -655,6 +660,8 @@ class PWARX(BaseEstimator):
         est.units_ = {}
         return est
 
+
+MIN_ABS_SCALE = 1e-100  # a signal whose values are all smaller is refused (the mirror of MAX_ABS_VALUE)
 
 LIBRARY_REMEDY = ("resample it, or fit the arrays with breaks at the gaps: "
                   "fit(data.inputs, data.output, breaks=[...])")

@@ -30,6 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hwpts.dataset import dense_real  # noqa: F401 - the package imports it from here too
 from hwpts.errors import DataError, ParameterError
 
 __all__ = ["RegressorStructure", "as_order_tuple"]
@@ -325,30 +326,6 @@ class RegressorStructure:
 
 
 MAX_ABS_VALUE = 1e100  # largest magnitude of a signal value: its square (and sums of them) stay finite
-
-
-def dense_real(values, label: str) -> np.ndarray:
-    """``values`` as a float array; sparse, complex or non-numeric input is refused (a cast would
-    drop the imaginary part or fail without saying which argument)."""
-    if hasattr(values, "tocsr") or hasattr(values, "toarray"):
-        raise DataError(f"{label} is a sparse matrix; pass a dense array ({label}.toarray())")
-    arr = np.asarray(values)
-    if np.iscomplexobj(arr):
-        raise DataError(f"{label} is complex; hwpts models real signals (pass the real part or the magnitude)")
-    if arr.dtype.kind in "mM":  # numpy casts dates to nanosecond counts without a word
-        raise DataError(f"{label} holds dates or durations ({arr.dtype}); hwpts models numeric signals (pass the "
-                        f"time as the dataset's time axis, not as a signal)")
-    if arr.dtype.kind in "US" or (arr.dtype.kind == "O" and any(isinstance(v, (str, bytes)) for v in arr.flat)):
-        # as scikit-learn: text is not read as numbers, even where it could be (a DataFrame column
-        # of strings, an object array, a numpy array of text alike)
-        raise DataError(f"{label} holds text ({arr.dtype}); convert it to numbers first "
-                        f"({label}.astype(float) where every entry is one)")
-    if arr.dtype.kind not in "biuf":
-        try:
-            arr = arr.astype(float)
-        except (TypeError, ValueError):
-            raise DataError(f"{label} must hold numbers, got values of type {arr.dtype}") from None
-    return np.asarray(arr, dtype=float)
 
 
 def validate_inputs(inputs, n_inputs: int | None = None) -> np.ndarray:

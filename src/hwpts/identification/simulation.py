@@ -16,6 +16,9 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
+from hwpts.dataset import dense_real
+from hwpts.errors import DataError
+
 __all__ = ["SimulationResult", "simulate_pwarx", "one_step_pwarx", "free_run_sensitivity"]
 
 
@@ -49,7 +52,11 @@ class SimulationResult:
         ``nan`` when the run diverged (the one encoding of "diverged" in the package)."""
         from hwpts.identification.metrics import fit_percent
 
-        y = np.asarray(measured, dtype=float).ravel()
+        y = dense_real(measured, "measured")
+        if y.ndim == 2 and y.shape[1] == 1:
+            y = y[:, 0]
+        if y.ndim != 1:
+            raise DataError(f"measured must be the output, shape (n,) or (n, 1); got shape {y.shape}")
         if self.diverged:
             return float("nan")
         m = self.n_initial

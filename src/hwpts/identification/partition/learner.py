@@ -131,14 +131,19 @@ class PartitionLearner(BaseEstimator):
 
         if not is_count(s, 1):
             raise ParameterError(f"PartitionLearner: s (the number of regions) must be an int >= 1, got {s!r}")
-        X = np.asarray(X, dtype=float)
-        y = np.asarray(y, dtype=float)
+        from hwpts.dataset import dense_real
+
+        X, y = dense_real(X, "X"), dense_real(y, "y")
         raw = np.asarray(labels)
         if X.ndim != 2 or y.ndim != 1 or raw.ndim != 1 or not X.shape[0] == y.shape[0] == raw.shape[0]:
             raise DataError(f"PartitionLearner: expected X of shape (n, p), y and labels of shape (n,), got "
                             f"{X.shape}, {y.shape} and {raw.shape}")
-        if X.shape[0] == 0 or not (np.all(np.isfinite(X)) and np.all(np.isfinite(y))):
-            raise DataError("PartitionLearner: X and y must hold at least one row of finite numbers")
+        if X.shape[0] == 0:
+            raise DataError("PartitionLearner: X and y must hold at least one row")
+        for label, values in (("X", X), ("y", y)):
+            if not np.all(np.isfinite(values)):
+                row = int(np.argwhere(~np.isfinite(values.reshape(values.shape[0], -1)))[0, 0])
+                raise DataError(f"PartitionLearner: {label} has a non-finite value (NaN or inf) at row {row}")
         if raw.dtype.kind not in "iu" and not (raw.dtype.kind in "bf" and np.array_equal(raw, np.round(raw))):
             raise DataError(f"PartitionLearner: labels must be whole numbers 0 .. {s - 1}, got values of type "
                             f"{raw.dtype}")
@@ -146,6 +151,18 @@ class PartitionLearner(BaseEstimator):
         if labels.min() < 0 or labels.max() >= s:
             raise DataError(f"PartitionLearner: labels must lie in 0 .. {s - 1}, got {labels.min()} .. {labels.max()}")
         return X, y, labels
+
+    @staticmethod
+    def _check_columns(columns, n_columns):
+        """``columns`` as a sorted list of distinct column indices of X (``None``: every column)."""
+        if columns is None:
+            return None
+        values = list(np.atleast_1d(np.asarray(columns, dtype=object)))
+        if not values or any(isinstance(c, bool) or not isinstance(c, (int, np.integer)) or not 0 <= c < n_columns
+                             for c in values) or len(set(values)) != len(values):
+            raise ParameterError(f"PartitionLearner: columns must be distinct indices of X's columns 0 .. "
+                                 f"{n_columns - 1} (at least one) or None, got {columns!r}")
+        return sorted(int(c) for c in values)
 
     def learn(self, X, y, labels, s, constant=True, columns=None, init=None):
         """``(labels, partition, sparse_columns)`` for the rows ``X`` labelled ``labels``
@@ -156,6 +173,7 @@ class PartitionLearner(BaseEstimator):
 
         self.check_params()
         X, y, labels = self._check_rows(X, y, labels, s)
+        columns = self._check_columns(columns, X.shape[1])
         rng = np.random.default_rng(self.random_state)
         # the first classifier on at most classifier_rows rows drawn at random (every region kept):
         # far more rows hardly move a logistic boundary and cost a Newton step each

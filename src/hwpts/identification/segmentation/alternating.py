@@ -351,6 +351,7 @@ class AlternatingSegmenter(Segmenter):
 
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
         """Labels from alternating assignment and least squares with restarts (see the module docstring)."""
+        X, y, rng = self._check_rows(X, y, rng)
         self.check_params()
         self._check_regions(n_regions, X.shape[0])
         s = n_regions

@@ -16,6 +16,7 @@ class AverageSegmenter(Segmenter):
 
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
         """One region holding every row: a single ARX model."""
+        X, y, rng = self._check_rows(X, y, rng)
         from hwpts.identification.partition import RegionPartition
 
         return SegmentationResult(np.zeros(X.shape[0], dtype=np.int64), 1,

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from sklearn.base import BaseEstimator
 
-from hwpts.errors import ParameterError
+from hwpts.errors import DataError, ParameterError
 from hwpts.identification.threads import single_threaded
 
 
@@ -71,6 +71,28 @@ class Segmenter(BaseEstimator):
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:  # pragma: no cover
         """Assign the regressor rows ``X`` with targets ``y`` to ``n_regions`` regions; returns a :class:`SegmentationResult` (labels, and a partition when the method defines one)."""
         raise NotImplementedError
+
+    @staticmethod
+    def _check_rows(X, y, rng):
+        """``(X, y, rng)`` as :meth:`segment` works on them: the regressor rows ``X`` (n, p) and
+        their targets ``y`` (n,), finite, and ``rng`` a numpy ``Generator`` (an int or ``None``
+        seeds one, as scikit-learn's ``random_state``); else one line naming the argument."""
+        from hwpts.dataset import dense_real
+
+        X, y = dense_real(X, "X"), dense_real(y, "y")
+        if X.ndim != 2:
+            raise DataError(f"X must be the regressor rows, shape (n, p); got shape {X.shape}")
+        if y.ndim != 1 or y.shape[0] != X.shape[0]:
+            raise DataError(f"y must be the targets of X's {X.shape[0]} rows, shape ({X.shape[0]},); got shape {y.shape}")
+        for label, values in (("X", X), ("y", y)):
+            if not np.all(np.isfinite(values)):
+                row = int(np.argwhere(~np.isfinite(values.reshape(values.shape[0], -1)))[0, 0])
+                raise DataError(f"{label} has a non-finite value (NaN or inf) at row {row}")
+        if not isinstance(rng, np.random.Generator):
+            if rng is not None and (isinstance(rng, bool) or not isinstance(rng, (int, np.integer)) or rng < 0):
+                raise ParameterError(f"rng must be a numpy Generator, an int >= 0 or None, got {rng!r}")
+            rng = np.random.default_rng(rng)
+        return X, y, rng
 
     def _check_regions(self, n_regions, n_rows):
         if not isinstance(n_regions, (int, np.integer)) or n_regions < 1:

@@ -93,6 +93,7 @@ class ClusteringSegmenter(Segmenter):
 
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
         """Labels from clustering the local-model features of Ferrari-Trecate et al. (see the module docstring)."""
+        X, y, rng = self._check_rows(X, y, rng)
         self.check_params()
         self._check_regions(n_regions, X.shape[0])
         p = X.shape[1] + 1

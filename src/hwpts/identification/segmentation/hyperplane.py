@@ -85,11 +85,12 @@ class HyperplaneSegmenter(Segmenter):
 
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
         """The decision list of the user's hyperplanes as a fixed partition (m hyperplanes, m + 1 regions)."""
+        X, y, rng = self._check_rows(X, y, rng)
         hps = self.parsed()
         if not hps:
             raise ParameterError(
-                "segmentation 'hyperplane' needs at least one hyperplane (--hyperplane \"a,b,c\" "
-                "meaning a*x1 + b*x2 + c >= 0)"
+                "segmentation 'hyperplane' needs at least one hyperplane: hyperplanes=[\"a,b,c\"] meaning "
+                "a*x1 + b*x2 + c >= 0 (on the command line --hyperplane \"a,b,c\")"
             )
         partition = hyperplane_partition(hps, structure)
         labels = partition.predict(X)

@@ -37,6 +37,7 @@ class KMeansSegmenter(Segmenter):
 
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
         """Labels from k-means on the standardised regressors."""
+        X, y, rng = self._check_rows(X, y, rng)
         self.check_params()
         self._check_regions(n_regions, X.shape[0])
         Z = standardize(np.column_stack([X, y]) if self.include_output else X)

@@ -204,6 +204,7 @@ class SwitchedSegmenter(Segmenter):
 
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
         """Labels of ``n_regions`` modes over the regions each covers (see the module docstring)."""
+        X, y, rng = self._check_rows(X, y, rng)
         self.check_params()
         self._check_regions(n_regions, X.shape[0])
         K = int(n_regions)

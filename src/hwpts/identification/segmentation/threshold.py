@@ -363,6 +363,7 @@ class ThresholdSegmenter(Segmenter):
         """The exact least-squares thresholds on the chosen column (or the best column), as a fixed
         partition. ``columns``: the regressor columns a threshold may use (a PWARX's
         ``partition_columns``); default all."""
+        X, y, rng = self._check_rows(X, y, rng)
         self.check_params()
         self._check_regions(n_regions, X.shape[0])
         if not 0 < self.min_share < 1 / max(n_regions, 2):

@@ -63,6 +63,7 @@ class ThresholdAlternatingSegmenter(Segmenter):
 
     def segment(self, X, y, n_regions, structure, rng, columns=None) -> SegmentationResult:
         """The threshold split's labels, alternated to a local minimum; no fixed partition."""
+        X, y, rng = self._check_rows(X, y, rng)
         self.check_params()
         try:
             split = ThresholdSegmenter(column=self.column, n_grid=self.n_grid, min_share=self.min_share).segment(

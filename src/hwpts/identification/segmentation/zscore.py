@@ -40,6 +40,7 @@ class ZScoreSegmenter(Segmenter):
 
     def segment(self, X, y, n_regions, structure, rng) -> SegmentationResult:
         """Two regions: rows whose output's z-score is at least ``threshold``, and the rest."""
+        X, y, rng = self._check_rows(X, y, rng)
         self.check_params()
         sd = float(np.std(y))
         if sd == 0:
