@@ -453,3 +453,23 @@ def test_a_time_indexed_frame_gives_its_sample_time_and_data_at_another_rate_are
     with pytest.raises(DataError, match="steps 0.01 s, but 0.02 s from row 300"):
         PWARX(1, 1, 1).fit(pd.DataFrame({"u": u[:, 0]}, index=slower), y, breaks=[300])
     assert model.score(u, y) == model.score(frame, output)  # arrays carry no rate to check
+
+
+def test_search_messages_name_the_orders_and_the_cv_and_a_failed_fit_leaves_no_old_results():
+    """{"output_order": 2} raised 'int' object is not iterable; orders up to 200 on 300 samples
+    said only that the samples were too few; cv=1000 did not name cv; a second fit that failed
+    kept the first fit's best_estimator_ beside its own new attributes."""
+    from sklearn.exceptions import NotFittedError
+
+    u, y = two_modes()
+    single = PWARXSearch(PWARX(random_state=0), orders={"output_order": 1, "input_order": [1], "input_delay": [1]},
+                         methods="threshold", output_powers=None, try_polish=False).fit(u, y)
+    assert single.best_params_["output_order"] == 1
+    with pytest.raises(ParameterError, match=r"the largest lag, 200, is that of the orders \{'output_order': 200"):
+        PWARXSearch(PWARX(random_state=0), orders={"output_order": [1, 200]}).fit(u[:300], y[:300])
+    with pytest.raises(ParameterError, match=r"PWARXSearch: cv=1000: 300 samples cannot make 1000 blocks"):
+        PWARXSearch(PWARX(1, 1, 1, random_state=0), cv=1000).fit(u[:300], y[:300])
+    with pytest.raises(ParameterError, match="too few to choose a model"):
+        single.fit(u[:5], y[:5])
+    with pytest.raises(NotFittedError):
+        single.predict(u, y)

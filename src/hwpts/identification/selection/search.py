@@ -96,6 +96,8 @@ __all__ = ["PWARXSearch", "expand_grid", "DEFAULT_METHODS", "ORDER_GRID"]
 DEFAULT_METHODS = ("threshold", "alternating")
 ORDER_GRID = {"output_order": (0, 1, 2, 3, 4), "input_order": (1, 2, 3, 4), "input_delay": (1, 0)}
 ORDER_KEYS = ("output_order", "input_order", "input_delay")
+FITTED_ATTRIBUTES = ("best_estimator_", "best_params_", "best_score_", "cv_results_", "input_delays_", "modes_gate_",
+                     "n_splits_", "orders_ranking_", "scoring_")
 MIN_BLOCK = 10  # samples of a held-out block, beyond the initial conditions
 REGION_CAP = 10  # regions the adaptive search grows to by its usual rule (max_regions="auto") ...
 REGION_HARD_CAP = 40  # ... and at most beyond it, while each count sets a new best free-run fit
@@ -509,7 +511,9 @@ class PWARXSearch(BaseEstimator):
             unknown = set(self.orders) - set(ORDER_KEYS)
             if unknown:
                 raise ParameterError(f"PWARXSearch: orders has unknown keys {sorted(unknown)}; valid are {list(ORDER_KEYS)}")
-            grid = {k: v if isinstance(v, str) else tuple(v) for k, v in self.orders.items()}
+            # a single value is one candidate ({"output_order": 2}: 'int' object is not iterable)
+            grid = {k: v if isinstance(v, str) else tuple(v) if hasattr(v, "__iter__") else (v,)
+                    for k, v in self.orders.items()}
         else:
             raise ParameterError(f"PWARXSearch: orders must be None, 'auto' or a dict of lists, got {self.orders!r}")
         if isinstance(grid.get("input_delay"), str):
@@ -573,7 +577,10 @@ class PWARXSearch(BaseEstimator):
                 cv = BlockedSplit(k, min_block=min_block)
         elif isinstance(cv, (int, np.integer)) and not isinstance(cv, bool):
             cv = BlockedSplit(int(cv), min_block=min_block)
-        splits = [(np.asarray(tr), np.asarray(te)) for tr, te in cv.split(np.zeros((n, 1)))]
+        try:
+            splits = [(np.asarray(tr), np.asarray(te)) for tr, te in cv.split(np.zeros((n, 1)))]
+        except (ParameterError, ValueError) as error:  # BlockedSplit's, or scikit-learn's TimeSeriesSplit's
+            raise ParameterError(f"PWARXSearch: cv={self.cv!r}: {error}") from None
         for train, test in splits:
             if max_lag > 0 and (test.size <= max_lag + 1 or np.any(np.diff(test) != 1)):
                 raise ParameterError(f"PWARXSearch: every test block must be contiguous and longer than "
@@ -633,6 +640,9 @@ class PWARXSearch(BaseEstimator):
         """
         from hwpts.identification.pwarx import data_sample_time
 
+        # a fit that fails leaves no earlier fit's results beside this one's first (half old, half new)
+        for name in FITTED_ATTRIBUTES:
+            self.__dict__.pop(name, None)
         # an IODataset's or a time-indexed DataFrame's (the search takes no breaks)
         sample_time = data_sample_time(X, sample_time, remedy="resample it, or search each stretch on its own")
         from hwpts.identification.pwarx import check_fit_arguments
@@ -658,7 +668,14 @@ class PWARXSearch(BaseEstimator):
         self.input_delays_ = None
         order_grid = self._order_grid(base, u, yy)
         max_lag = max(self._max_lag(base, o) for o in order_grid)
-        splits = self._splits(n, max_lag)
+        try:
+            splits = self._splits(n, max_lag)
+        except ParameterError as error:
+            if len(order_grid) < 2 or max_lag == 0 or self.cv is not None:
+                raise
+            deepest = max(order_grid, key=lambda o: self._max_lag(base, o))  # name what asks for the lags
+            raise ParameterError(f"{error} (the largest lag, {max_lag}, is that of the orders {deepest}: search "
+                                 f"smaller ones)") from None
         for number, (_, test) in enumerate(splits, start=1):
             if test.size > max_lag and np.ptp(yy[test[max_lag:]]) == 0:
                 raise DataError(f"PWARXSearch: the output is constant over held-out block {number} of {len(splits)} "
