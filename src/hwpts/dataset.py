@@ -32,6 +32,10 @@ def dense_real(values, label: str) -> np.ndarray:
         # of strings, an object array, a numpy array of text alike)
         raise DataError(f"{label} holds text ({arr.dtype}); convert it to numbers first "
                         f"({label}.astype(float) where every entry is one)")
+    if arr.dtype.kind == "O" and arr.size:  # pandas' nullable columns: a missing value (pd.NA, None) is NaN
+        missing = np.frompyfunc(lambda v: v is None or type(v).__name__ == "NAType", 1, 1)(arr).astype(bool)
+        if missing.any():
+            arr = np.where(missing, np.nan, arr)
     if arr.dtype.kind not in "biuf":
         try:
             arr = arr.astype(float)
@@ -91,6 +95,10 @@ class IODataset:
             )
         if len(names) != inputs.shape[1]:
             raise DataError(f"{inputs.shape[1]} input columns but {len(names)} input names {names}")
+        if not isinstance(self.output_name, str) or not self.output_name:
+            raise DataError(f"output_name must be a non-empty string, got {self.output_name!r}")
+        if len(set(names)) != len(names) or self.output_name in names:
+            raise DataError(f"the input names {list(names)} and the output name {self.output_name!r} must be distinct")
         checks = [("time", time), (str(self.output_name), output)]
         checks += [(name, inputs[:, j]) for j, name in enumerate(names)]
         for label, values in checks:
@@ -187,8 +195,12 @@ class IODataset:
                 raise DataError(f"the time column {time_name!r} has a non-finite value (NaN, inf or an empty "
                                 f"cell) at row {bad}")
         else:
+            if isinstance(sample_time, bool) or not isinstance(sample_time, (int, float, np.integer, np.floating)) \
+                    or not (np.isfinite(sample_time) and sample_time > 0):
+                raise DataError(f"sample_time must be a positive number of seconds (the data have no time column "
+                                f"{time_name!r}), got {sample_time!r}")
             time = np.arange(n) * float(sample_time)
-        inputs = np.column_stack([np.asarray(columns[c], dtype=float) for c in input_names])
+        inputs = np.column_stack([dense_real(columns[c], repr(c)) for c in input_names])
         return cls(time, inputs, columns[output_name], tuple(input_names), output_name)
 
 

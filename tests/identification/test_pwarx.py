@@ -584,3 +584,40 @@ def test_a_signal_too_small_to_fit_is_refused():
     small = PWARX(1, 1, 1, n_regions=1, segmentation="average").fit(u * 1e-90, y)
     assert small.score(u * 1e-90, y) == pytest.approx(
         PWARX(1, 1, 1, n_regions=1, segmentation="average").fit(u, y).score(u, y), abs=1e-9)
+
+
+def test_edge_messages_of_the_library_review():
+    """Each said something else before: save_model(m, 5) an OS TypeError, an unfitted
+    divergence_band an AttributeError, 3 rows 'n_regions=1 is too many ... at most 1', a score
+    on 1 sample after the initial conditions 'undefined for a constant measured output', a
+    nullable column with pd.NA 'values of type object', sample_time=0 'time must be strictly
+    increasing', duplicate names nothing (until fit)."""
+    from sklearn.exceptions import NotFittedError
+
+    from hwpts.io.models import load_model, save_model
+
+    rng = np.random.default_rng(0)
+    u = rng.uniform(-1, 1, 400)
+    y = np.cumsum(u) * 0.1 + 0.01 * rng.standard_normal(400)
+    model = PWARX(3, 1, 1, n_regions=1, segmentation="average").fit(u, y)
+    with pytest.raises(ParameterError, match="path must be a file path .* got 5"):
+        save_model(model, 5)
+    with pytest.raises(ParameterError, match="path must be a file path"):
+        load_model(None)
+    with pytest.raises(NotFittedError):
+        PWARX().divergence_band()
+    with pytest.raises(DataError, match="3 regressor rows are too few for a model of 3 parameters a region: at least 4"):
+        PWARX(1, 1, 1, n_regions=1, segmentation="threshold").fit(u[:4], y[:4])
+    with pytest.raises(DataError, match="a fit % needs at least 2 samples after the 3 initial conditions, got 1"):
+        model.score(u[:4], y[:4])
+    pd = pytest.importorskip("pandas")
+    frame = pd.DataFrame({"u": pd.array(u, dtype="Float64")})
+    frame.loc[5, "u"] = pd.NA
+    with pytest.raises(DataError, match="inputs has a non-finite value .* at row 5"):
+        PWARX(1, 1, 1).fit(frame, y)
+    with pytest.raises(DataError, match="sample_time must be a positive number of seconds"):
+        IODataset.from_columns({"u": u, "y": y}, ["u"], "y", sample_time=0)
+    with pytest.raises(DataError, match="must be distinct"):
+        IODataset(np.arange(400.0), np.c_[u, u], y, ("u", "u"), "y")
+    with pytest.raises(DataError, match="output_name must be a non-empty string, got None"):
+        IODataset(np.arange(400.0), u, y, ("u",), None)

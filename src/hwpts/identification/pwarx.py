@@ -365,6 +365,9 @@ class PWARX(BaseEstimator):
             pcols = sorted({structure.column_index(c) for c in self.partition_column_names()})
         if segmenter.uses_n_regions and isinstance(self.n_regions, (int, np.integer)) \
                 and not isinstance(self.n_regions, bool) and self.n_regions > X_reg.shape[0] // (structure.n_features + 2):
+            if X_reg.shape[0] < structure.n_features + 2:  # not one region's worth ("at most 1" for 1)
+                raise DataError(f"{X_reg.shape[0]} regressor rows are too few for a model of {structure.n_features + 1} "
+                                f"parameters a region: at least {structure.n_features + 2} rows")
             raise ParameterError(
                 f"n_regions={self.n_regions} is too many for {X_reg.shape[0]} regressor rows of "
                 f"{structure.n_features + 1} parameters each: at most {max(X_reg.shape[0] // (structure.n_features + 2), 1)}"
@@ -527,6 +530,7 @@ class PWARX(BaseEstimator):
 
     def divergence_band(self) -> tuple[float, float]:
         """(center, half-width) of the output band beyond which a free run counts as diverged."""
+        check_is_fitted(self, "theta_")
         lo, hi = self.output_range_
         center = 0.5 * (lo + hi)
         half = max(0.5 * (hi - lo), 1e-9 * max(abs(center), 1.0))

@@ -60,6 +60,9 @@ class SimulationResult:
         if self.diverged:
             return float("nan")
         m = self.n_initial
+        if y.shape[0] - m < 2:  # said as the signal being empty or constant before
+            raise DataError(f"a fit % needs at least 2 samples after the {m} initial conditions, got "
+                            f"{max(y.shape[0] - m, 0)}")
         return fit_percent(y[m:], self.output[m:])
 
 

@@ -166,7 +166,14 @@ def save_model(model, path: str | os.PathLike, before_commit=None, argument: str
     """
     from hwpts.io.atomic import write_text_atomic
 
+    _check_path(path, argument)
     write_text_atomic(path, dumps_model(model), before_commit, argument)
+
+
+def _check_path(path, argument: str = "path") -> None:
+    """``path`` a file path (``str`` or ``os.PathLike``), else one line naming ``argument``."""
+    if not isinstance(path, (str, os.PathLike)) or isinstance(path, bool):
+        raise ParameterError(f"{argument} must be a file path (a str or pathlib.Path), got {path!r}")
 
 
 def _reject_constant(token):
@@ -177,6 +184,7 @@ def load_model(path: str | os.PathLike):
     """Read and validate a model file; return a fitted :class:`~hwpts.identification.PWARX`."""
     from hwpts.io.paths import check_input_file
 
+    _check_path(path)
     p = check_input_file(path, "model ", "a .json model file")
     try:
         text = p.read_text(encoding="utf-8-sig")  # a byte-order mark (a Windows editor's) is no content
