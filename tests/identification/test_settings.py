@@ -473,3 +473,15 @@ def test_search_messages_name_the_orders_and_the_cv_and_a_failed_fit_leaves_no_o
         single.fit(u[:5], y[:5])
     with pytest.raises(NotFittedError):
         single.predict(u, y)
+
+
+def test_cv_takes_a_list_of_train_test_pairs_and_checks_them():
+    """scikit-learn's searches take cv as (train, test) pairs; it was refused, printing every index."""
+    u, y = two_modes()
+    idx = np.arange(600)
+    search = PWARXSearch(PWARX(1, 1, 1, random_state=0), cv=[(idx[:400], idx[400:]), (idx[200:], idx[:200])],
+                         methods="threshold", output_powers=None, try_polish=False).fit(u, y)
+    assert search.n_splits_ == 2 and len(search.cv_results_[0]["split_fits_percent"]) == 2
+    with pytest.raises(ParameterError, match=r"cv=\[\(array\(\[ 0, 1, .*\.\.\.: every train and test part must be "
+                                             r"non-empty sample indices 0 .. 599"):
+        PWARXSearch(PWARX(1, 1, 1), cv=[(idx[:400], idx[400:] + 100)]).fit(u, y)

@@ -188,6 +188,12 @@ FOLD_MAX_ROWS = 5000  # rows a learned segmentation labels in a cross-validation
 # the choice from 6 to 8 regions on 2 of 10 data sets (median one-step fit 95.4 -> 94.4 %)
 
 
+def _short(value, width: int = 60) -> str:
+    """``repr(value)`` on one line, cut to ``width`` characters (a list of index arrays is long)."""
+    text = " ".join(repr(value).split())
+    return text if len(text) <= width else f"{text[:width - 3]}..."
+
+
 def _candidate(estimator, params):
     """A new estimator with the candidate's ``params``, as the folds fit it."""
     model = clone(estimator).set_params(**params)
@@ -338,10 +344,10 @@ class PWARXSearch(BaseEstimator):
         refused with a line saying how to keep them, not silently replaced.
     param_grid : dict, list, or None
         Explicit candidates (see :func:`expand_grid`); ``None`` runs the adaptive search (module doc).
-    cv : int, splitter or None
+    cv : int, splitter, list or None
         Number of blocks of :class:`BlockedSplit`, or any splitter yielding ``(train, test)`` index
         arrays with a contiguous ``test`` (``sklearn.model_selection.TimeSeriesSplit``,
-        :class:`HoldoutSplit`). Default: 5 blocks (3 beyond 5,000 samples, where each block is
+        :class:`HoldoutSplit`), or a list of such ``(train, test)`` pairs. Default: 5 blocks (3 beyond 5,000 samples, where each block is
         long enough to visit every regime), fewer (down to 2) when the record is short; for a static
         map (no lagged signal in the regressor) a shuffled ``KFold`` instead, since the order of the
         rows carries nothing and contiguous blocks of data sorted along an input would only test
@@ -577,10 +583,20 @@ class PWARXSearch(BaseEstimator):
                 cv = BlockedSplit(k, min_block=min_block)
         elif isinstance(cv, (int, np.integer)) and not isinstance(cv, bool):
             cv = BlockedSplit(int(cv), min_block=min_block)
+        elif not hasattr(cv, "split"):  # (train, test) pairs, as scikit-learn's searches take them
+            from sklearn.model_selection import check_cv
+
+            cv = check_cv(cv)
+        shown = _short(self.cv)
         try:
             splits = [(np.asarray(tr), np.asarray(te)) for tr, te in cv.split(np.zeros((n, 1)))]
-        except (ParameterError, ValueError) as error:  # BlockedSplit's, or scikit-learn's TimeSeriesSplit's
-            raise ParameterError(f"PWARXSearch: cv={self.cv!r}: {error}") from None
+        except (ParameterError, ValueError, TypeError) as error:  # BlockedSplit's, or scikit-learn's
+            raise ParameterError(f"PWARXSearch: cv={shown}: {error}") from None
+        for train, test in splits:
+            for part in (train, test):
+                if part.size == 0 or part.dtype.kind not in "iu" or part.min() < 0 or part.max() >= n:
+                    raise ParameterError(f"PWARXSearch: cv={shown}: every train and test part must be non-empty "
+                                         f"sample indices 0 .. {n - 1}")
         for train, test in splits:
             if max_lag > 0 and (test.size <= max_lag + 1 or np.any(np.diff(test) != 1)):
                 raise ParameterError(f"PWARXSearch: every test block must be contiguous and longer than "
@@ -995,9 +1011,11 @@ class PWARXSearch(BaseEstimator):
             raise ParameterError(f"PWARXSearch: try_polish must be True, False or 'auto', got {self.try_polish!r}")
         check_bool(self.progress, "progress", owner)
         cv = self.cv
-        if not (cv is None or is_count(cv, 2) or (hasattr(cv, "split") and not isinstance(cv, (str, bytes)))):
-            raise ParameterError(f"PWARXSearch: cv must be None, an int >= 2 (blocks) or a splitter with split(), "
-                                 f"got {cv!r}")
+        if not (cv is None or is_count(cv, 2) or ((hasattr(cv, "split") or hasattr(cv, "__iter__"))
+                                                  and not isinstance(cv, (str, bytes, dict)))):
+            shown = _short(cv)
+            raise ParameterError(f"PWARXSearch: cv must be None, an int >= 2 (blocks), a splitter with split() or "
+                                 f"a list of (train, test) index arrays, got {shown}")
         if self.n_jobs is not None and (isinstance(self.n_jobs, bool) or not isinstance(self.n_jobs, (int, np.integer))
                                         or self.n_jobs == 0):
             raise ParameterError(f"PWARXSearch: n_jobs must be None or a non-zero int (-1: every core), got {self.n_jobs!r}")
