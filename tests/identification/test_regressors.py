@@ -74,3 +74,11 @@ def test_a_name_that_means_two_columns_is_refused_not_guessed():
     st = RegressorStructure.create(1, 1, 1, 1, input_names=["u"], output_name="u(k-1)")
     with pytest.raises(ParameterError, match="ambiguous"):
         st.column_index("u(k-1)")
+
+
+@pytest.mark.parametrize("bad", [[True], {1}, [1.0], 2.0, "1"])
+def test_per_input_orders_are_ints_as_the_scalar_ones(bad):
+    """[True], {1} and [1.0] were taken while 2.0 was refused (and a set has no input order)."""
+    with pytest.raises(ParameterError, match=r"nb \(input order\) must be an int or a list of ints \(one per input\)"):
+        RegressorStructure.create(1, bad, 1, 1)
+    assert RegressorStructure.create(1, np.array([2]), [np.int32(1)], 1).nb == (2,)

@@ -41,12 +41,12 @@ def as_order_tuple(value, n_inputs: int, name: str, minimum: int) -> tuple[int, 
     if isinstance(value, (int, np.integer)) and not isinstance(value, bool):
         values = (int(value),) * n_inputs
     else:
-        try:
-            values = tuple(int(v) for v in value)
-        except (TypeError, ValueError):
-            raise ParameterError(f"{name} must be an int or a list of ints, got {value!r}") from None
-        if any(int(v) != v for v in value):
-            raise ParameterError(f"{name} must hold integers, got {value!r}")
+        # one int per input, in order: a list, tuple or integer array (not a set, whose order is
+        # none; nor True or 1.0, which the scalar forms refuse as well)
+        if isinstance(value, (str, bytes, set, frozenset, dict)) or not hasattr(value, "__iter__") \
+                or not all(isinstance(v, (int, np.integer)) and not isinstance(v, (bool, np.bool_)) for v in value):
+            raise ParameterError(f"{name} must be an int or a list of ints (one per input), got {value!r}")
+        values = tuple(int(v) for v in value)
         if len(values) != n_inputs:
             raise ParameterError(
                 f"{name} has {len(values)} entries but there are {n_inputs} inputs; "
