@@ -53,7 +53,9 @@ def umask_mode(base: int = 0o666) -> int:
 
 
 def check_output_path(path: str | os.PathLike, what: str = "--out") -> Path:
-    """Refuse an output that is a folder, a symbolic link, a device or a FIFO (never replaced)."""
+    """Refuse an output that is a folder, a symbolic link, a device or a FIFO (never replaced), or
+    whose path is not UTF-8 text (:func:`check_utf8_path`)."""
+    check_utf8_path(path, what)
     target = Path(path)
     try:
         link = target.is_symlink()
@@ -70,6 +72,19 @@ def check_output_path(path: str | os.PathLike, what: str = "--out") -> Path:
             raise DataError(f"{what} {str(target)!r}: is a device, FIFO or socket, not a regular file; "
                             f"hwpts never replaces one")
     return target
+
+
+def check_utf8_path(path: str | os.PathLike, what: str = "--out") -> None:
+    """Refuse an output path holding bytes that are not UTF-8 (a name typed in another encoding):
+    its name goes into reports and summaries, which are UTF-8 text (a traceback before)."""
+    text = os.fspath(path)
+    if isinstance(text, bytes):
+        text = os.fsdecode(text)
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:
+        shown = text.encode("utf-8", "surrogateescape").decode("ascii", "backslashreplace")
+        raise DataError(f"{what} '{shown}': the path holds bytes that are not UTF-8; give a UTF-8 path") from None
 
 
 def process_alive(pid: int) -> bool:

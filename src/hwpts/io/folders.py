@@ -11,13 +11,14 @@ import tempfile
 from pathlib import Path
 
 from hwpts.errors import DataError
-from hwpts.io.atomic import commit_allowed, point_of_no_return, umask_mode
+from hwpts.io.atomic import check_utf8_path, commit_allowed, point_of_no_return, umask_mode
 
 
 def check_replaceable(path: str | os.PathLike, schema: str, marker: str = "summary.json") -> None:
     """Refuse a target that exists and is not empty, unless it is an earlier run of ``schema``."""
     if not str(path).strip():  # Path("") is the current folder
         raise DataError("--out: expected an output folder's path, got an empty one")
+    check_utf8_path(path)
     out = Path(path)
     if out.is_symlink():
         raise DataError(f"--out {str(out)!r}: is a symbolic link; hwpts never replaces a link, give the path "
