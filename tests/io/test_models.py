@@ -168,3 +168,25 @@ def test_saving_what_is_not_a_fitted_model_is_one_clear_error(tmp_path):
     # a column name the file's 'a,b,c@col1,col2' text cannot hold is refused when the hyperplane is made
     with pytest.raises(ParameterError, match="column name cannot hold"):
         Hyperplane([1.0], 0.0, ["p,q"])
+
+
+def test_a_model_that_would_not_load_is_not_written(tmp_path):
+    """An input of 1e-99 driving an output of 1e5 fitted gains of 1e103: identify wrote the file and
+    exited 0, and every command that read it refused it ('beyond +-1e+100')."""
+    from hwpts.errors import DataError, ParameterError
+    from hwpts.identification import PWARX
+    from hwpts.identification.partition import Hyperplane
+    from hwpts.io.models import save_model
+
+    rng = np.random.default_rng(0)
+    u = rng.uniform(-1, 1, 400)
+    y = np.zeros(400)
+    for k in range(1, 400):
+        y[k] = 0.5 * y[k - 1] + u[k - 1]
+    model = PWARX(1, 1, 1, n_regions=1, segmentation="average").fit(u * 1e-99, y * 1e5)
+    path = tmp_path / "m.json"
+    with pytest.raises(DataError, match=r"cannot be written as a model file: regions\[0\].theta holds .*beyond"):
+        save_model(model, path)
+    assert not path.exists()
+    with pytest.raises(ParameterError, match="within \\+-1e100"):
+        Hyperplane([1e200], 9e198)

@@ -145,8 +145,17 @@ def model_to_dict(model) -> dict:
 
 
 def dumps_model(model) -> str:
-    """The model file's text (indented JSON, schema ``hwpts.pwarx/1``)."""
-    return json.dumps(model_to_dict(model), indent=1, allow_nan=False) + "\n"
+    """The model file's text (indented JSON, schema ``hwpts.pwarx/1``); a model that
+    :func:`load_model` would refuse (a parameter beyond +-1e100: signals of very different scales)
+    is refused here, before any file is written (``identify`` wrote it and exited 0)."""
+    doc = model_to_dict(model)
+    text = json.dumps(doc, indent=1, allow_nan=False) + "\n"
+    try:
+        model_from_dict(json.loads(text))
+    except HwptsError as error:
+        raise DataError(f"the fitted model cannot be written as a model file: {error}; rescale the signals so "
+                        f"that the model's parameters stay within +-{MAX_MODEL_NUMBER:.0e}") from None
+    return text
 
 
 def save_model(model, path: str | os.PathLike, before_commit=None, argument: str = "path") -> None:

@@ -261,8 +261,9 @@ class Hyperplane:
         self.columns = None if columns is None else tuple(str(c) for c in columns)
         if not self.coefficients:
             raise ParameterError("a hyperplane needs at least one coefficient")
-        if not all(np.isfinite(self.coefficients)) or not np.isfinite(self.offset):
-            raise ParameterError(f"hyperplane coefficients must be finite, got {self}")
+        if not all(np.isfinite(self.coefficients)) or not np.isfinite(self.offset) \
+                or max(map(abs, (*self.coefficients, self.offset))) > 1e100:  # the model file's bound
+            raise ParameterError(f"hyperplane coefficients must be finite and within +-1e100, got {self}")
         for c in self.columns or ():
             if "," in c or "@" in c or c != c.strip():  # the model file writes "a,b,c@col1,col2"
                 raise ParameterError(f"a hyperplane's column name cannot hold ',' or '@' or surrounding spaces "
