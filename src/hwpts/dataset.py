@@ -194,6 +194,9 @@ class IODataset:
                 bad = int(np.argmax(~np.isfinite(time)))
                 raise DataError(f"the time column {time_name!r} has a non-finite value (NaN, inf or an empty "
                                 f"cell) at row {bad}")
+            if time.ndim == 1 and time.size > 1 and not np.all(np.diff(time) > 0):
+                bad = int(np.argmax(~(np.diff(time) > 0))) + 1
+                raise DataError(f"the time column {time_name!r} must be strictly increasing; it is not at row {bad}")
         else:
             if isinstance(sample_time, bool) or not isinstance(sample_time, (int, float, np.integer, np.floating)) \
                     or not (np.isfinite(sample_time) and sample_time > 0):

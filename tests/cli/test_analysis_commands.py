@@ -131,6 +131,13 @@ def test_a_time_column_is_found_by_its_conventional_name(tmp_path, capsys):
     assert main(["validate", str(model), str(shuffled)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "'t' is taken as the time column by its name; --time none uses the sample index" in err[0]
+    # a column named by --time is the time axis: one that does not increase was dropped without a
+    # word (and with it the rate check: data at another rate validated at exit 0)
+    odd = tmp_path / "odd.csv"
+    write_csv(odd, {"t": t / 10, "u1": u[:, 0], "u2": u[:, 1], "y": y, "temp": np.cos(t)})
+    assert main(["validate", str(model), str(odd), "--time", "temp"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "the time column 'temp' must be strictly increasing; it is not at row" in err[0]
 
 
 def test_columns_are_matched_by_name_and_can_be_mapped(files, tmp_path, capsys):

@@ -166,8 +166,9 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
             raise DataError(f"{str(path)!r}: column {name!r} has a non-finite value (NaN, inf or an empty cell) at "
                             f"row {offset + int(np.argmax(bad))} (data rows count from 0 after the header, as --rows)")
     # a column of a name beyond the conventional ones is the time axis only where it increases
-    # (T_h-like names aside, a time_min column of minima is no axis): else it is left alone
-    soft = [c for c in candidates if c in cols and c not in TIME_COLUMNS
+    # (T_h-like names aside, a time_min column of minima is no axis): else it is left alone; one
+    # named by --time is the time axis, or refused (it was dropped, and the rate check with it)
+    soft = [c for c in candidates if c in cols and c not in TIME_COLUMNS and time_name is None
             and not (np.all(np.isfinite(np.asarray(cols[c], dtype=float)))
                      and np.all(np.diff(np.asarray(cols[c], dtype=float)) > 0))]
     tname = next((c for c in candidates if c in cols and c not in soft), None)
