@@ -621,3 +621,21 @@ def test_edge_messages_of_the_library_review():
         IODataset(np.arange(400.0), np.c_[u, u], y, ("u", "u"), "y")
     with pytest.raises(DataError, match="output_name must be a non-empty string, got None"):
         IODataset(np.arange(400.0), u, y, ("u",), None)
+
+
+def test_an_offset_that_leaves_the_model_too_few_digits_is_refused():
+    """The same record 1e12 higher (an output of 25 units around 1e12) fitted a free run of
+    45.9 % for 79.2 %, with no word; 1e8 higher it fits as the record itself."""
+    rng = np.random.default_rng(0)
+    u = rng.uniform(-1, 1, 600)
+    y = np.zeros(600)
+    for k in range(1, 600):
+        y[k] = 0.9 * y[k - 1] + u[k - 1] + 0.01 * rng.standard_normal()
+    with pytest.raises(DataError, match=r"signal 'y' varies by .* around 1e\+12: an offset .* times its variation .* "
+                                        r"subtract it first \(y - 1e\+12\)"):
+        PWARX(1, 1, 1).fit(u, y + 1e12)
+    with pytest.raises(DataError, match="signal 'u1' varies by"):
+        PWARX(1, 1, 1).fit(u + 1e11, y)
+    base = PWARX(1, 1, 1, n_regions=1, segmentation="average").fit(u, y)
+    shifted = PWARX(1, 1, 1, n_regions=1, segmentation="average").fit(u, y + 1e8)
+    assert shifted.score(u, y + 1e8) == pytest.approx(base.score(u, y), abs=1e-3)
