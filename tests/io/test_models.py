@@ -65,6 +65,14 @@ def _edit(path, fn, fix_checksum=True):
     (lambda d: d["training"]["input_ranges"][0].reverse(), True, r"input_ranges must be \[low, high\] pairs"),
     (lambda d: d["structure"].update(input_names=["u1", "u1"]), True, "structure.input_names names 'u1' twice"),
     (lambda d: d["structure"].update(nk=[20000] * len(d["structure"]["nk"])), True, "largest lag .* is beyond"),
+    # found by a review, 2026-11-27: each was accepted (nk 3000 without n_samples: a 181 MB export)
+    (lambda d: (d["structure"].update(nk=[3000] * len(d["structure"]["nk"])), d["training"].pop("n_samples")), True,
+     "largest lag .* is beyond 1,000 in a file without training.n_samples"),
+    (lambda d: d["training"].update(n_samples=1000.0), True, "training.n_samples must be an int >= 0"),
+    (lambda d: d["regions"][0]["theta_covariance"][0].__setitem__(0, -1.0), True, "negative variance"),
+    (lambda d: d.setdefault("signals", {}).update(units={"nobody": "V"}), True, "names 'nobody', which is no signal"),
+    (lambda d: d.setdefault("signals", {}).update(units={"y": "V\n"}), True, r"units\['y'\] must be printable"),
+    (lambda d: d.setdefault("signals", {}).update(sample_time_s=1e-320), True, "sample_time_s must be a number"),
 ])
 def test_bad_model_files(model_file, edit, fix, match):
     _edit(model_file, edit, fix)

@@ -325,10 +325,8 @@ class PWARX(BaseEstimator):
         breaks = _check_breaks(breaks, yy.shape[0])
         sample_time = data_sample_time(X, sample_time, breaks)  # an IODataset's or a time-indexed DataFrame's
         n_inputs = u.shape[1]
-        names = tuple(names) if names is not None else default_input_names(n_inputs)
-        if oname is None:  # the output unnamed: "y", unless an input has that name
-            oname = "y" if "y" not in names else "y_out"
-        _check_names(names, oname, n_inputs)
+        names, oname = signal_names(names, oname, n_inputs)
+        check_units(units, names, oname)
         structure = RegressorStructure.create(*self.given_orders(), n_inputs, self.constant, names, oname,
                                               self.output_powers, *power_scaling(yy))
         structure.check_length(yy.shape[0])
@@ -767,6 +765,27 @@ def check_fit_arguments(sample_time, units, output_name) -> None:
         raise ParameterError(f"units must be a dict {{signal name: unit}} or None, got {units!r}")
     if output_name is not None and (not isinstance(output_name, str) or not output_name):
         raise ParameterError(f"output_name must be a non-empty string, got {output_name!r}")
+
+
+def signal_names(names, output_name, n_inputs) -> tuple[tuple[str, ...], str]:
+    """The inputs' and the output's names a fit gives its model: those given, else ``u1, u2, ...``
+    and ``y`` (``y_out`` where an input is named ``y``); checked (:func:`_check_names`)."""
+    names = tuple(names) if names is not None else default_input_names(n_inputs)
+    if output_name is None:  # the output unnamed: "y", unless an input has that name
+        output_name = "y" if "y" not in names else "y_out"
+    _check_names(names, output_name, n_inputs)
+    return names, output_name
+
+
+def check_units(units, names, output_name) -> None:
+    """``units`` (``{signal: unit}``) names signals of the model, with printable units: another
+    name was kept and written, and the model file was then refused by every command."""
+    for name, unit in dict(units or {}).items():
+        if name not in (*names, output_name):
+            raise ParameterError(f"units names {name!r}, which is no signal of the model "
+                                 f"({[*names, output_name]})")
+        if not isinstance(unit, str) or not unit.isprintable():
+            raise ParameterError(f"units[{name!r}] must be printable text, got {unit!r}")
 
 
 def _check_names(names, output_name, n_inputs):

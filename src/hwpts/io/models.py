@@ -226,6 +226,7 @@ def _require(doc, key, kind, where):
 
 
 MAX_MODEL_NUMBER = 1e100  # beyond it a parameter or boundary overflows in the first products
+MAX_LAG_WITHOUT_RECORD = 1000  # largest lag of a model file that does not say its record's length
 
 
 def _has_leaf(value, kind: type) -> bool:
@@ -294,11 +295,17 @@ def _signals_section(section, structure) -> tuple[float | None, dict]:
         raise DataError("signals must be an object")
     dt = section.get("sample_time_s")
     if dt is not None and (isinstance(dt, bool) or not isinstance(dt, (int, float)) or not math.isfinite(dt)
-                           or dt <= 0):
-        raise DataError(f"signals.sample_time_s must be a positive number or null, got {dt!r}")
+                           or dt < 1e-12):  # 1e-320 s was read, and said as "(inf Hz)"
+        raise DataError(f"signals.sample_time_s must be a number of seconds >= 1e-12, or null, got {dt!r}")
     units = section.get("units") or {}
     if not isinstance(units, dict) or not all(isinstance(k, str) and isinstance(v, str) for k, v in units.items()):
         raise DataError("signals.units must map signal names to unit strings")
+    known = {*structure.input_names, structure.output_name}
+    for name, unit in units.items():
+        if name not in known:
+            raise DataError(f"signals.units names {name!r}, which is no signal of the model ({sorted(known)})"[:300])
+        if not unit.isprintable():  # a line break went on into the exports
+            raise DataError(f"signals.units[{name!r}] must be printable text, got {unit!r}"[:200])
     return (None if dt is None else float(dt)), dict(units)
 
 
@@ -315,6 +322,10 @@ def _covariance(reg: dict, i: int, nf: int) -> np.ndarray:
         arr = np.array([[np.nan if v is None else v for v in row] for row in value], dtype=float)
     except (TypeError, ValueError):
         raise DataError(f"regions[{i}].theta_covariance must hold numbers") from None
+    diagonal = np.diagonal(arr)
+    # (nan: unknown; a fit's round-off leaves -4e-26 beside variances of 1e-3 on a column it pins)
+    if np.any(diagonal < -1e-9 * np.nanmax(np.abs(diagonal), initial=0.0)):
+        raise DataError(f"regions[{i}].theta_covariance has a negative variance on its diagonal")
     return arr
 
 
@@ -407,11 +418,17 @@ def model_from_dict(doc: dict):
     if np.any(in_ranges[:, 0] > in_ranges[:, 1]):
         raise DataError("training.input_ranges must be [low, high] pairs, got a low above its high")
     n_samples = training.get("n_samples")
+    if n_samples is not None and not (_is_int(n_samples) and n_samples >= 0):
+        raise DataError(f"training.n_samples must be an int >= 0, got {n_samples!r}"[:200])
     if _is_int(n_samples) and structure.max_lag > n_samples:  # (a model from parts has n_samples = max_lag)
         # a fit needs more samples than lags: orders edited beyond the record (nk 20000 on 4,000
         # samples took gigabytes to export)
         raise DataError(f"the orders' largest lag ({structure.max_lag}) is beyond training.n_samples "
                         f"({n_samples}): no fit on that record could have them")
+    if n_samples is None and structure.max_lag > MAX_LAG_WITHOUT_RECORD:
+        # the key left out (files before it, or deleted): nk 3000 exported a 181 MB file
+        raise DataError(f"the orders' largest lag ({structure.max_lag}) is beyond {MAX_LAG_WITHOUT_RECORD:,} in a "
+                        f"file without training.n_samples; refit the model with 'hwpts identify'")
     seg = doc.get("segmentation") or {}
     model = PWARX.from_parts(structure, partition, np.array(theta), kinds, out_range, in_ranges,
                              segmentation_info=seg if isinstance(seg, dict) else {})

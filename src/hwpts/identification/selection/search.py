@@ -670,6 +670,9 @@ class PWARXSearch(BaseEstimator):
         # method's own settings are the candidates', which replace the method: checked with them)
         base._check_settings(segmenter=False)
         u, yy, names, oname = base._signals(X, y, input_names, output_name)
+        from hwpts.identification.pwarx import check_units, signal_names
+
+        check_units(units, *signal_names(names, oname, u.shape[1]))  # before the search, not after it
         self._check_orders(base, u.shape[1])
         if np.ptp(yy) == 0:
             raise DataError(f"output {oname or 'y'!r} is constant in the training data ({yy[0]:.6g}); "
