@@ -349,6 +349,9 @@ CASES = [
     (["residuals", f"{W}/model.json", f"{W}/data.csv", "--lags", "100000"], "lags"),
     (["residuals", f"{W}/model.json", f"{W}/data.csv", "--confidence", "1.5"], "--confidence"),
     (["residuals", f"{W}/model.json", f"{W}/data.csv", "--confidence", "high"], "--confidence"),
+    # a band of +-inf (1 - 1e-16 rounds 0.5 + c / 2 to 1) called any residual white, at exit 0
+    (["residuals", f"{W}/model.json", f"{W}/data.csv", "--confidence", "0.9999999999999999"],
+     "expected a probability in (0.5, 0.999999999]"),
     (["residuals", f"{W}/missing.json", f"{W}/data.csv"], "missing.json"),
     (["residuals", f"{W}/model.json", f"{W}/data.csv", "--plot", f"{W}/data.csv.png", "--input", "a"], "--input"),
     (["predict", f"{W}/clash.json", f"{W}/clash.csv", "--out", f"{W}/p.csv"],

@@ -33,7 +33,7 @@ def cmd_residuals(args) -> int:
         print(json_text(result))
         return 0
     share = result["outside_share"]
-    conf = f"{100 * result['confidence']:g} %"
+    conf = f"{100 * result['confidence']:.12g} %"  # 99.9999999, not 100
     print(f"residuals: {result['n_residuals']} one-step residuals of {model.structure_.output_name!r}, "
           f"rms {result['residual_rms']:.6g}")
     if result["exact"]:
@@ -84,15 +84,15 @@ def register(subparsers):
 
     def confidence(text):
         value = finite_float(text)
-        if not 0.5 < value < 1:
-            raise argparse.ArgumentTypeError(f"expected a probability in (0.5, 1), got {text!r}")
+        if not 0.5 < value <= 1 - 1e-9:  # 1 - 1e-16: a band of +-inf called every residual white
+            raise argparse.ArgumentTypeError(f"expected a probability in (0.5, 0.999999999], got {text!r}")
         return value
 
     r = subparsers.add_parser(
         "residuals", help="whiteness and input-correlation tests of a model's one-step residuals",
         description="Autocorrelation of the one-step residuals of MODEL on DATA and their cross-correlation "
                     "with each input, with a confidence band (MATLAB's resid). A correct model leaves white "
-                    "residuals, uncorrelated with past inputs: about 1 %% of lags outside the 99 %% band.")
+                    "residuals, uncorrelated with past inputs: about 1 % of lags outside the 99 % band.")
     r.add_argument("model", metavar="MODEL.json")
     r.add_argument("data", metavar="DATA")
     r.add_argument("--lags", type=positive_int, default=25, metavar="L", help="largest lag tested [samples] (default 25)")

@@ -67,7 +67,7 @@ def residual_figure(analysis, *, output_name: str = "y", unit: str | None = None
     axes = np.atleast_1d(axes)
     share = analysis.outside_share()
     band = analysis.band
-    conf = f"{100 * analysis.confidence:g} % band"
+    conf = f"{100 * analysis.confidence:.12g} % band"
     lags = np.arange(analysis.lags + 1)
 
     def panel(ax, values, first_lag, what, outside):
