@@ -199,3 +199,19 @@ def test_a_model_file_without_the_signals_section_still_loads(files, tmp_path):
     old.write_text(json.dumps(doc))
     model = load_model(old)
     assert model.sample_time_ is None and model.units_ == {}
+
+
+def test_resample_takes_a_jittered_time_axis(files, tmp_path, capsys):
+    """--resample refused a time column with jitter ('not uniformly sampled ... resample the data')
+    although resampling is what it does: it interpolates it onto the model's grid; without it the
+    message names --resample."""
+    t, u, y = _second_order()
+    jittered = t + np.random.default_rng(1).uniform(-0.002, 0.002, t.size) * (np.arange(t.size) > 0)
+    path = tmp_path / "jit.csv"
+    write_csv(path, {"time_s": jittered, "valve_v": u[:, 0], "u2": u[:, 1], "y_mm": y})
+    assert main(["validate", str(files / "good.json"), str(path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "not uniformly sampled" in err[0] and "or pass --resample to interpolate it" in err[0]
+    assert main(["validate", str(files / "good.json"), str(path), "--resample", "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert result["n_samples"] >= 2999 and result["free_run_fit_percent"] > 50  # (its end is jittered)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import re
 import sys
 import time
@@ -92,9 +93,11 @@ def _available(path, found) -> str:
     return text
 
 
-def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
+def _load_dataset(path, input_names, output_name, time_name=None, rows=None, uniform=True):
     """The named columns of a data file as an :class:`IODataset`; its ``sample_time_s`` attribute
     is the sample period from the time column, or None when the file has none (time = row index).
+    ``uniform``: a time column that is not uniform is refused (``None``: with ``--resample`` as the
+    remedy), or ``False``: taken, with a sample period of ``nan`` (to be resampled).
 
     Without ``time_name`` the time column is the first of :data:`TIME_COLUMNS` the file holds (a
     numeric column; one that is not a signal), so that a model that knows its sample time is never
@@ -192,7 +195,12 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None):
     try:
         dt = _sample_time(data, path, tname) if timed else None
     except DataError as error:
-        raise DataError(f"{error}{hint}") from None
+        if uniform is False and "not uniformly sampled" in str(error):
+            dt = math.nan  # jitter or gaps: a time axis all the same, to be resampled (--resample)
+        elif uniform is None:  # a command that resamples when asked: say so
+            raise DataError(f"{error}, or pass --resample to interpolate it onto the model's rate{hint}") from None
+        else:
+            raise DataError(f"{error}{hint}") from None
     if period is not None:
         name, value = period
         if dt is None:
@@ -268,6 +276,8 @@ def _check_sample_time(model, data, dt, path, resample: bool):
             return IODataset(data.time * model_dt, data.inputs, data.output, data.input_names, data.output_name,
                              extra=data.extra)
         return data
+    if resample and math.isnan(dt):  # a time axis with jitter or gaps: onto the model's uniform grid
+        return _resampled(data, dt, model_dt)
     if abs(dt - model_dt) <= SAMPLE_TIME_TOLERANCE * model_dt:
         return data
     if resample:
@@ -844,7 +854,8 @@ def _model_and_data(args):
     output = args.output or st.output_name
     _check_signals(inputs, output)
     _check_mapped_units(model, inputs, output)
-    data, dt = _load_dataset(args.data, inputs, output, args.time, args.rows)
+    data, dt = _load_dataset(args.data, inputs, output, args.time, args.rows,
+                             uniform=False if args.resample else None)
     data = _check_sample_time(model, data, dt, args.data, args.resample)
     st.check_length(data.n_samples, what=_selection(args, repr(str(args.data))))
     return model, data
