@@ -745,3 +745,17 @@ def test_a_missing_cell_outside_the_selected_rows_does_not_matter(tmp_path, caps
         # inside a selection, the row is the file's (as --rows counts), not the selection's
         _expect_error(capsys, ["identify", str(path), *IDENTIFY, "--segmentation", "average", "--rows", "300:",
                                "--out", str(tmp_path / "m2.json")], "at row 600 (data rows count from 0")
+
+
+@pytest.mark.parametrize("ts, said", [("0.01", "but it holds no numbers (text"), (np.array([0.01, 0.02]), "got 2 values")])
+def test_a_mat_sample_time_that_is_no_number_is_refused(tmp_path, capsys, ts, said):
+    """A .mat Ts saved as text or as a vector was passed over without a word (and with it the
+    rate check), while Ts = 0 was refused."""
+    path = tmp_path / "d.mat"
+    rng = np.random.default_rng(0)
+    savemat(path, {"u": rng.random(200), "y": rng.random(200), "Ts": ts})
+    out = tmp_path / "m.json"
+    _expect_error(capsys, ["identify", str(path), "--input", "u", "--output", "y", "--na", "1", "--nb", "1",
+                           "--out", str(out)], f"the variable 'Ts' is taken as the sample time in seconds; expected", out)
+    main(["identify", str(path), "--input", "u", "--output", "y", "--na", "1", "--nb", "1", "--out", str(out)])
+    assert said in capsys.readouterr().err

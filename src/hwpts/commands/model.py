@@ -218,10 +218,22 @@ def _mat_sample_time(path, columns) -> tuple[str, float] | None:
 
     if Path(path).suffix.lower() != ".mat":
         return None
+    from hwpts.io.datasets import mat_unread
+
+    unread = None
     for name in MAT_SAMPLE_TIMES:
         value = columns.get(name)
-        if value is None or np.size(value) != 1:
+        if value is None:
+            unread = mat_unread(path) if unread is None else unread
+            if name in unread:  # text, or no vector: said, not passed over (the rate check with it)
+                raise DataError(f"{str(path)!r}: the variable {name!r} is taken as the sample time in seconds; "
+                                f"expected a positive number, but it {unread[name]} (pass --time COL for a time "
+                                f"column, or --time none for the sample index)")
             continue
+        if np.size(value) != 1:
+            raise DataError(f"{str(path)!r}: the variable {name!r} is taken as the sample time in seconds; expected "
+                            f"one positive number, got {np.size(value)} values (pass --time COL for a time column, or "
+                            f"--time none for the sample index)")
         value = float(np.asarray(value, dtype=float).reshape(-1)[0])
         if not (np.isfinite(value) and value > 0):
             raise DataError(f"{str(path)!r}: the variable {name!r} is taken as the sample time in seconds; expected "
