@@ -151,3 +151,14 @@ def test_help_on_every_command(capsys):
             main(argv)
         assert exc.value.code == 0
         assert "usage:" in capsys.readouterr().out
+
+
+def test_a_sweep_at_a_standing_pump_gives_no_percent_of_full_scale(tmp_path, capsys):
+    """--pump-speeds 0:0:1 said 'largest hysteresis gap 42.7 % of full scale (0.0 r/min)': a share
+    of a response spanning a few thousandths of a r/min."""
+    from hwpts.cli import main
+
+    assert main(["plant", "sweep", "--out", str(tmp_path / "s.csv"), "--pump-speeds", "0:0:1", "--voltages",
+                 "1.5:3.5:5"]) == 0
+    out = capsys.readouterr().out
+    assert "no full scale" in out and "% of full scale" not in out

@@ -124,8 +124,13 @@ def sweep_command(args) -> int:
     result = sweep(PlantParameters.paper(), voltages, pumps)
     write_table(args.out, sweep_columns(result))
     gap_rpm = float(np.max(np.abs(result.up_rpm - result.down_rpm)))
-    gap = (f"largest hysteresis gap {np.max(np.abs(result.gap_percent)):.1f} % of full scale ({gap_rpm:.1f} r/min)"
-           if result.points_per_sweep > 1 else f"hysteresis gap {gap_rpm:.1f} r/min (one operating point: no full scale)")
+    both = np.concatenate([result.up_rpm.ravel(), result.down_rpm.ravel()])
+    if result.points_per_sweep < 2:
+        gap = f"hysteresis gap {gap_rpm:.1f} r/min (one operating point: no full scale)"
+    elif np.ptp(both) < 1.0:  # the pump at 0 r/min: 42.7 % of a full scale of a few thousandths
+        gap = f"largest hysteresis gap {gap_rpm:.3g} r/min (the motor's speed spans {np.ptp(both):.3g} r/min: no full scale)"
+    else:
+        gap = f"largest hysteresis gap {np.max(np.abs(result.gap_percent)):.1f} % of full scale ({gap_rpm:.1f} r/min)"
     print(f"wrote {shown_path(args.out)}: {result.points_per_sweep} points per sweep (up, down, average); {gap}",
           file=sys.stderr if is_stdout(args.out) else sys.stdout)
     return 0
