@@ -566,6 +566,9 @@ def _check_partition_columns(args, fixed, searched, powers=()) -> None:
 
     if not args.partition_column:
         return
+    twice = next((c for i, c in enumerate(args.partition_column) if c in args.partition_column[:i]), None)
+    if twice is not None:  # (stored twice, while --input u --input u is refused)
+        raise ParameterError(f"--partition-column {twice!r} is given twice; give each column once")
     na = fixed.get("output_order", max(searched.get("output_order", [0])))
     nb = fixed.get("input_order", max(searched.get("input_order", [1])))
     delays = [fixed["input_delay"]] if "input_delay" in fixed else list(searched.get("input_delay", [1]))
@@ -650,6 +653,12 @@ def cmd_identify(args) -> int:
     # a given partition (the user's hyperplanes, average's one region, zscore's rule): neither
     # learned nor drawn on the data, so no count to check against the rows and no method to choose
     fixed_partition = segmentation in SEGMENTATION_METHODS and SEGMENTATION_METHODS[segmentation].given_partition()
+    if fixed_partition and args.partition_column:  # (it was ignored)
+        raise ParameterError(f"--partition-column restricts the boundaries a segmentation learns; --segmentation "
+                             f"{segmentation} has a given partition (leave one of them out)")
+    if args.shared_modes == "on" and segmentation != "auto":  # (it was ignored)
+        raise ParameterError(f"--shared-modes on: the search tries the switched segmentation beside its methods; "
+                             f"--segmentation {segmentation} fixes the method (leave one of them out)")
     if not fixed_partition and searched and fixed:
         # (a fixed partition's grid search splits by the given orders' lags alone)
         _check_fixed_lags(fixed, searched, data.n_samples, _selection(args, repr(str(args.data))))
@@ -716,6 +725,9 @@ def cmd_identify(args) -> int:
                                  try_polish=try_polish, n_regions=n_regions)
         else:
             search = PWARXSearch(model, param_grid=dict(searched), progress=True, try_polish=False)
+    if search is None and args.scoring != "auto":  # (it was ignored)
+        raise ParameterError(f"--scoring {args.scoring} ranks the candidates of a search; with the orders, the "
+                             f"segmentation and the regions all given there is none (leave --scoring out)")
     if search is not None:
         shared = {"auto": "auto", "on": True, "off": False}[args.shared_modes]
         if segmentation not in (None, "auto"):
