@@ -100,6 +100,7 @@ def workspace(tmp_path_factory):
         "typotime.csv": "time_s,u1,u2,y\n" + "".join(f"{'15.0.1' if i == 5 else i * 0.1},{i % 4},{i % 3},{i}\n"
                                                       for i in range(40)),
         "underscore.csv": "u1,u2,y\n" + "".join(f"{'1_000' if i == 5 else i % 4},{i % 3},{i}\n" for i in range(40)),
+        "decimal_comma.csv": "u1;u2;y\n" + "".join(f"{i % 4},5;{i % 3};{i}\n" for i in range(40)),
         # a time axis of numbers with a dash in every fifth cell: broken, not absent (it was dropped
         # below 90 % numbers, and with it the sample-time check)
         "dashtime.csv": "time_s,u1,u2,y\n" + "".join(f"{'-' if i % 5 == 4 else i * 0.1},{i % 4},{i % 3},{i}\n"
@@ -163,6 +164,8 @@ CASES = [
     # resampled record too long for memory
     (["validate", f"{W}/model.json", f"{W}/typotime.csv"], "line 7, column 'time_s': expected a number, got '15.0.1'"),
     (["identify", f"{W}/underscore.csv", *FIXED, "--out", f"{W}/m.json"], "got '1_000'"),
+    (["identify", f"{W}/decimal_comma.csv", *FIXED, "--out", f"{W}/m.json"],
+     "got '0,5' (a decimal comma: write the numbers with a point, 0.5)"),
     (["identify", f"{W}/data.csv", *FIXED, "--rows", "1_0:50", "--out", f"{W}/m.json"], "--rows expects START:STOP"),
     # numbers as one rule reads them everywhere (hwpts.text): Python's int and float also take
     # "1_0" and non-ASCII digits ("\u0663" is an Arabic-Indic three), a command line and a CSV do not

@@ -273,8 +273,10 @@ def _read_csv_python(p: Path, delimiter: str = ",", columns=None) -> dict[str, n
             try:
                 values[k, j] = plain_float(cell)
             except ValueError:
+                comma = re.fullmatch(r"[+-]?\d*,\d+([eE][+-]?\d+)?", cell.strip())  # a European file's 0,5
                 raise DataError(f"{str(p)!r} line {i}, column {header[j]!r}: expected a number, "
-                                f"got {cell.strip()!r}") from None
+                                f"got {cell.strip()!r}"
+                                f"{' (a decimal comma: write the numbers with a point, 0.5)' if comma else ''}") from None
     return {header[j]: values[:, j].copy() for j in wanted}
 
 
