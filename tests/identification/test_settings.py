@@ -452,7 +452,8 @@ def test_a_time_indexed_frame_gives_its_sample_time_and_data_at_another_rate_are
     slower = index[:300].append(pd.date_range(index[299] + pd.Timedelta("1s"), periods=300, freq="20ms"))
     with pytest.raises(DataError, match="steps 0.01 s, but 0.02 s from row 300"):
         PWARX(1, 1, 1).fit(pd.DataFrame({"u": u[:, 0]}, index=slower), y, breaks=[300])
-    assert model.score(u, y) == model.score(frame, output)  # arrays carry no rate to check
+    with pytest.warns(UserWarning, match="X has no column names"):
+        assert model.score(u, y) == model.score(frame, output)  # arrays carry no rate to check
 
 
 def test_search_messages_name_the_orders_and_the_cv_and_a_failed_fit_leaves_no_old_results():
@@ -485,3 +486,21 @@ def test_cv_takes_a_list_of_train_test_pairs_and_checks_them():
     with pytest.raises(ParameterError, match=r"cv=\[\(array\(\[ 0, 1, .*\.\.\.: every train and test part must be "
                                              r"non-empty sample indices 0 .. 599"):
         PWARXSearch(PWARX(1, 1, 1), cv=[(idx[:400], idx[400:] + 100)]).fit(u, y)
+
+
+def test_arrays_for_a_model_fitted_on_named_columns_warn_as_scikit_learn():
+    """Columns were taken by position without a word where the fit took them by name."""
+    pd = pytest.importorskip("pandas")
+    u, y = two_modes()
+    model = PWARX(1, 1, 1, segmentation="threshold").fit(pd.DataFrame({"valve": u[:, 0]}), y)
+    assert list(model.feature_names_in_) == ["valve"]
+    with pytest.warns(UserWarning, match=r"X has no column names, but the model was fitted on a DataFrame with "
+                                         r"columns \['valve'\]"):
+        model.predict(u, y)
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        model.predict(pd.DataFrame({"valve": u[:, 0]}), y)  # by name: no warning
+        model.fit(u, y).predict(u, y)  # refitted on arrays: none either
+    assert not hasattr(model, "feature_names_in_")

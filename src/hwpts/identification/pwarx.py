@@ -428,6 +428,10 @@ class PWARX(BaseEstimator):
         self.input_names_ = names
         self.output_name_ = structure.output_name
         self.n_features_in_ = n_inputs
+        if not isinstance(X, IODataset) and getattr(X, "columns", None) is not None:  # scikit-learn's: a DataFrame
+            self.feature_names_in_ = np.asarray(names, dtype=object)
+        else:
+            self.__dict__.pop("feature_names_in_", None)
         self.output_range_ = (float(yy.min()), float(yy.max()))
         self.input_ranges_ = np.column_stack([u.min(axis=0), u.max(axis=0)])
         self.segmentation_info_ = {"method": segmenter.name, **seg.info}
@@ -475,6 +479,11 @@ class PWARX(BaseEstimator):
                 raise DataError(f"the DataFrame's time index is sampled every {dt:.6g} s, the model every "
                                 f"{known:.6g} s: its lags would mean other delays; resample the data or refit")
             frame_names = _column_names(X)
+            if frame_names is None and hasattr(self, "feature_names_in_") and getattr(X, "ndim", 2) != 1:
+                # as scikit-learn: columns by position where the fit took them by name
+                warnings.warn(f"X has no column names, but the model was fitted on a DataFrame with columns "
+                              f"{list(self.feature_names_in_)}: its columns are taken by position", UserWarning,
+                              stacklevel=4)
             X = _as_array(X)
             if frame_names is not None:
                 X = _select_columns(X, frame_names, self.input_names_)
@@ -568,9 +577,15 @@ class PWARX(BaseEstimator):
         else:
             u, yy = self._check_inputs(X, y, need_y=m > 0)
             y0 = np.zeros(m) if yy is None else yy
+        return self._simulate_checked(u, y0, strict=initial_output is not None)
+
+    def _simulate_checked(self, u, y0, strict=False) -> SimulationResult:
+        """The free run of checked inputs ``u`` from the outputs ``y0`` (``strict``: all ``max_lag``
+        initial outputs needed, even for fewer samples)."""
+        m = self.structure_.max_lag
         if u.shape[0] == 0:
             raise DataError("simulate needs at least one sample of the inputs, got none")
-        if y0.shape[0] < min(m, u.shape[0]) or (initial_output is not None and y0.shape[0] < m):
+        if y0.shape[0] < min(m, u.shape[0]) or (strict and y0.shape[0] < m):
             raise DataError(f"need {m} initial outputs, got {y0.shape[0]}")
         center, half = self.divergence_band()
         return simulate_pwarx(self.structure_, self.partition_, self.theta_, u, y0, center, half)
@@ -578,7 +593,7 @@ class PWARX(BaseEstimator):
     def score(self, X, y=None) -> float:
         """Free-run fit % (NRMSE) after the initial conditions; ``nan`` (with a warning) if diverged."""
         u, yy = self._check_inputs(X, y)
-        sim = self.simulate(u, yy)
+        sim = self._simulate_checked(u, yy)  # (the data checked once: not again as arrays)
         if sim.diverged:
             warnings.warn(sim.reason, FreeRunDivergedWarning, stacklevel=2)
         return sim.score(yy)
