@@ -603,9 +603,9 @@ def test_a_run_under_nohup_outlives_a_closed_terminal(tmp_path):
 
 
 def test_a_path_that_is_not_utf8_is_refused_in_one_line(tmp_path, data_csv, capsys):
-    """An output (or input) name with a byte that is not UTF-8 ended in UnicodeEncodeError from the
-    atomic writer (identify, predict, export, plant simulate, validate --plot, reproduce at its
-    report), and an input's name in a figure title in matplotlib's TypeError."""
+    """An output name with a byte that is not UTF-8 ended in UnicodeEncodeError from the atomic
+    writer (identify, predict, export, plant simulate, validate --plot, reproduce at its report):
+    refused; an input's name in a figure title ended in matplotlib's TypeError: drawn escaped."""
     bad = os.fsdecode(b"m\xff.json")
     _one_line_error(capsys, ["identify", str(data_csv), *FIT, "--out", str(tmp_path / bad)],
                     "m\\xff.json': the path holds bytes that are not UTF-8")
@@ -613,8 +613,10 @@ def test_a_path_that_is_not_utf8_is_refused_in_one_line(tmp_path, data_csv, caps
     model = tmp_path / "m.json"
     assert main(["identify", str(data_csv), *FIT, "--out", str(model)]) == 0
     capsys.readouterr()
-    odd = tmp_path / os.fsdecode(b"d\xff.csv")
+    odd = tmp_path / os.fsdecode(b"d\xff.csv")  # an input of that name is read, its name drawn escaped
     odd.write_bytes(data_csv.read_bytes())
-    _one_line_error(capsys, ["validate", str(model), str(odd)], "input file '")
+    assert main(["validate", str(model), str(odd), "--plot", str(tmp_path / "v.png")]) == 0
+    assert (tmp_path / "v.png").stat().st_size > 1000
+    capsys.readouterr()
     _one_line_error(capsys, ["plant", "simulate", "--case", "case1", "--out", str(tmp_path / os.fsdecode(b"s\xff.csv"))],
                     "the path holds bytes that are not UTF-8")

@@ -17,10 +17,7 @@ def check_input_file(path: str | os.PathLike, what: str = "", expected: str = "a
     ``what`` prefixes the path in messages (``"model "``); ``expected`` says what the path should be
     (``"a .json model file"``).
     """
-    from hwpts.io.atomic import check_utf8_path
-
     p = Path(path)
-    check_utf8_path(p, f"{what}file".strip() if what else "input file")  # its name goes into titles and reports
     try:
         mode = os.stat(p).st_mode
     except FileNotFoundError:
