@@ -8,6 +8,8 @@ line on stderr with exit status 2 (no traceback).
 from __future__ import annotations
 
 import argparse
+import contextlib
+import io
 import os
 import shlex
 import signal
@@ -108,6 +110,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     previous: dict = {}
     hook = sys.unraisablehook
     _INTERRUPTED.clear()
+    for stream in (sys.stdout, sys.stderr):
+        # a file name's bytes that are not UTF-8 (kept as surrogates) printed escaped (\\udcff), not as a
+        # UnicodeEncodeError where the terminal's encoding is strict UTF-8
+        reconfigure = getattr(stream, "reconfigure", None)
+        if callable(reconfigure):
+            with contextlib.suppress(ValueError, OSError, io.UnsupportedOperation):
+                reconfigure(errors="backslashreplace")
     if threading.current_thread() is threading.main_thread():
         from hwpts._signals import interrupt_signals
 
