@@ -70,8 +70,6 @@ def _edit(path, fn, fix_checksum=True):
      "largest lag .* is beyond 1,000 in a file without training.n_samples"),
     (lambda d: d["training"].update(n_samples=1000.0), True, "training.n_samples must be an int >= 0"),
     (lambda d: d["regions"][0]["theta_covariance"][0].__setitem__(0, -1.0), True, "negative variance"),
-    (lambda d: d.setdefault("signals", {}).update(units={"nobody": "V"}), True, "names 'nobody', which is no signal"),
-    (lambda d: d.setdefault("signals", {}).update(units={"y": "V\n"}), True, r"units\['y'\] must be printable"),
     (lambda d: d.setdefault("signals", {}).update(sample_time_s=1e-320), True, "sample_time_s must be a number"),
 ])
 def test_bad_model_files(model_file, edit, fix, match):
@@ -198,3 +196,12 @@ def test_a_model_that_would_not_load_is_not_written(tmp_path):
     assert not path.exists()
     with pytest.raises(ParameterError, match="within \\+-1e100"):
         Hyperplane([1e200], 9e198)
+
+
+def test_units_of_no_signal_are_left_out_with_a_warning(model_file):
+    """A file written with units for a signal the model has not (fits before 2026-11-27 kept them)
+    loads without them; a unit with a line break (it went on into the exports) too."""
+    _edit(model_file, lambda d: d.setdefault("signals", {}).update(units={"nobody": "V", "y": "mm\n", "u1": "V"}))
+    with pytest.warns(UserWarning, match=r"the units of \['nobody', 'y'\] are left out"):
+        model = load_model(model_file)
+    assert model.units_ == {"u1": "V"}

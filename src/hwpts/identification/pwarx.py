@@ -330,7 +330,9 @@ class PWARX(BaseEstimator):
         structure = RegressorStructure.create(*self.given_orders(), n_inputs, self.constant, names, oname,
                                               self.output_powers, *power_scaling(yy))
         structure.check_length(yy.shape[0])
-        for name, values in [*zip(names, u.T), (structure.output_name, yy)]:
+        # the signals the regressor holds (an input of order 0 is not checked: it is not used)
+        used = [(name, values) for name, values, nb in zip(names, u.T, structure.nb) if nb > 0]
+        for name, values in [*used, (structure.output_name, yy)]:
             largest = float(np.max(np.abs(values)))
             if 0 < largest < MIN_ABS_SCALE:  # its least squares gave zero gains, with a warning only
                 raise DataError(f"signal {name!r} holds no value larger than {largest:.3g} in magnitude, below "
@@ -474,7 +476,8 @@ class PWARX(BaseEstimator):
         else:
             _check_index(X, y)
             known = getattr(self, "sample_time_", None)
-            dt = frame_sample_time(X, remedy="resample it (X.resample(...))")
+            dt = frame_sample_time(X, remedy="resample it (X.resample(...)), or give each stretch on its own "
+                                             "(X.loc[start:end])")
             if known is not None and dt is not None and abs(dt - known) > 0.01 * known:
                 raise DataError(f"the DataFrame's time index is sampled every {dt:.6g} s, the model every "
                                 f"{known:.6g} s: its lags would mean other delays; resample the data or refit")
@@ -689,8 +692,7 @@ class PWARX(BaseEstimator):
 MIN_ABS_SCALE = 1e-100  # a signal whose values are all smaller is refused (the mirror of MAX_ABS_VALUE)
 MAX_OFFSET_RATIO = 1e10  # a signal whose magnitude is more times its variation is refused (digits lost)
 
-LIBRARY_REMEDY = ("resample it, or fit the arrays with breaks at the gaps: "
-                  "fit(data.inputs, data.output, breaks=[...])")
+LIBRARY_REMEDY = "resample it, or give fit(data, breaks=[...]) the rows where each stretch starts"
 
 
 def frame_time(X) -> np.ndarray | None:
@@ -727,11 +729,20 @@ def frame_sample_time(X, breaks=(), remedy: str = FRAME_REMEDY) -> float | None:
     if repeated.size:
         raise DataError(f"the DataFrame's time index repeats a time stamp at row {int(repeated[0]) + 1} (two "
                         f"samples of one instant): drop or average the duplicates (X[~X.index.duplicated()])")
-    edges = [0, *sorted(int(b) for b in breaks or ()), time.size]
+    return stretch_sample_time(time, breaks, "the DataFrame's time index", remedy)
+
+
+def stretch_sample_time(time, breaks, what: str, remedy: str) -> float | None:
+    """The sample period [s] of the times ``time`` (:func:`hwpts.dataset.uniform_sample_time`),
+    each stretch between the ``breaks`` (rows where the record restarts) on its own: uniform within
+    each, and the same in all; ``None`` when no stretch has two samples."""
+    from hwpts.dataset import uniform_sample_time
+
+    edges = [0, *sorted(int(b) for b in breaks or ()), len(time)]
     found = []
     for a, b in zip(edges[:-1], edges[1:]):
         try:
-            dt = uniform_sample_time(time[a:b], "the DataFrame's time index", remedy)
+            dt = uniform_sample_time(time[a:b], what, remedy)
         except DataError as error:
             if a == 0:
                 raise
@@ -743,8 +754,8 @@ def frame_sample_time(X, breaks=(), remedy: str = FRAME_REMEDY) -> float | None:
     dt, _ = found[0]
     other = next(((d, a) for d, a in found if abs(d - dt) > 0.01 * dt), None)
     if other is not None:
-        raise DataError(f"the DataFrame's time index steps {dt:.6g} s, but {other[0]:.6g} s from row {other[1]}: "
-                        f"PWARX models need one sample time; resample the stretches to one rate")
+        raise DataError(f"{what} steps {dt:.6g} s, but {other[0]:.6g} s from row {other[1]}: PWARX models need one "
+                        f"sample time; resample the stretches to one rate")
     return dt
 
 
@@ -756,8 +767,8 @@ def data_sample_time(X, sample_time, breaks=(), remedy: str | None = None):
     ``remedy``: what a message on a non-uniform time says to do (default: resample or give breaks)."""
     from hwpts.identification.settings import is_number
 
-    if isinstance(X, IODataset):
-        uniform = X.uniform_sample_time("the dataset's time", remedy or LIBRARY_REMEDY)
+    if isinstance(X, IODataset):  # (a gap where the fit's breaks say the record restarts is no gap)
+        uniform = stretch_sample_time(X.time, breaks, "the dataset's time", remedy or LIBRARY_REMEDY)
         what = "the dataset's time"
     else:
         uniform, what = frame_sample_time(X, breaks, remedy or FRAME_REMEDY), "the DataFrame's time index"
@@ -774,8 +785,9 @@ def check_fit_arguments(sample_time, units, output_name) -> None:
     state changes: a bad one raised a TypeError from numpy, or after the fit had replaced the model."""
     from hwpts.identification.settings import is_number
 
-    if sample_time is not None and not is_number(sample_time, strict=True):
-        raise ParameterError(f"sample_time must be a positive number of seconds or None, got {sample_time!r}")
+    if sample_time is not None and not (is_number(sample_time, strict=True) and sample_time >= 1e-12):
+        raise ParameterError(f"sample_time must be a number of seconds >= 1e-12 (as a model file holds it) or "
+                             f"None, got {sample_time!r}")
     if units is not None and not isinstance(units, Mapping):
         raise ParameterError(f"units must be a dict {{signal name: unit}} or None, got {units!r}")
     if output_name is not None and (not isinstance(output_name, str) or not output_name):

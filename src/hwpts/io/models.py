@@ -153,8 +153,9 @@ def dumps_model(model) -> str:
     try:
         model_from_dict(json.loads(text))
     except HwptsError as error:
-        raise DataError(f"the fitted model cannot be written as a model file: {error}; rescale the signals so "
-                        f"that the model's parameters stay within +-{MAX_MODEL_NUMBER:.0e}") from None
+        scale = (f"; rescale the signals so that the model's parameters stay within +-{MAX_MODEL_NUMBER:.0e}"
+                 if "beyond" in str(error) else "")
+        raise DataError(f"the fitted model cannot be written as a model file: {error}{scale}") from None
     return text
 
 
@@ -301,11 +302,11 @@ def _signals_section(section, structure) -> tuple[float | None, dict]:
     if not isinstance(units, dict) or not all(isinstance(k, str) and isinstance(v, str) for k, v in units.items()):
         raise DataError("signals.units must map signal names to unit strings")
     known = {*structure.input_names, structure.output_name}
-    for name, unit in units.items():
-        if name not in known:
-            raise DataError(f"signals.units names {name!r}, which is no signal of the model ({sorted(known)})"[:300])
-        if not unit.isprintable():  # a line break went on into the exports
-            raise DataError(f"signals.units[{name!r}] must be printable text, got {unit!r}"[:200])
+    dropped = sorted(name for name, unit in units.items() if name not in known or not unit.isprintable())
+    if dropped:  # (files that fits before 2026-11-27 wrote: they load, without those units)
+        warnings.warn(f"signals.units: the units of {dropped} are left out (no signal of the model, or not "
+                      f"printable text: a line break went on into the exports)", UserWarning, stacklevel=4)
+        units = {name: unit for name, unit in units.items() if name not in dropped}
     return (None if dt is None else float(dt)), dict(units)
 
 
