@@ -98,7 +98,8 @@ def test_search_settings_are_checked(setting, match):
 
 
 @pytest.mark.parametrize("fit_args, match", [
-    (dict(sample_time="0.1"), "sample_time must be a positive number of seconds"),
+    (dict(sample_time="0.1"), "sample_time must be a number of seconds >= 1e-12"),
+    (dict(sample_time=1e-13), "sample_time must be a number of seconds >= 1e-12 .* got 1e-13"),
     (dict(units=5), "units must be a dict"),
     (dict(output_name=5), "output_name must be a non-empty string"),
 ])
