@@ -215,3 +215,13 @@ def test_resample_takes_a_jittered_time_axis(files, tmp_path, capsys):
     assert main(["validate", str(files / "good.json"), str(path), "--resample", "--json"]) == 0
     result = json.loads(capsys.readouterr().out)
     assert result["n_samples"] >= 2999 and result["fit_percent"] > 50  # (its end is jittered)
+
+
+def test_resample_refuses_to_bridge_a_gap(files, tmp_path, capsys):
+    """--resample filled a gap of 25 samples with a straight line, without a word."""
+    t, u, y = _second_order()
+    path = tmp_path / "gap.csv"
+    write_csv(path, {"time_s": t + 0.25 * (np.arange(t.size) >= 1500), "valve_v": u[:, 0], "u2": u[:, 1], "y_mm": y})
+    assert main(["validate", str(files / "good.json"), str(path), "--resample"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--resample: the time column has a gap of 0.26 s at row 1500" in err[0]

@@ -117,3 +117,15 @@ def test_residuals_of_an_exact_model_are_called_exact():
     assert exact.exact and exact.to_dict()["exact"] is True
     noisy = y + 0.05 * rng.standard_normal(800)
     assert not residual_analysis(model, u[:, None], noisy).exact
+
+
+def test_a_confidence_whose_band_is_infinite_is_refused():
+    """The command line refused 1 - 1e-16; the library returned a band of +-inf, 0 % outside."""
+    from hwpts.errors import ParameterError
+    from hwpts.identification.analysis import residual_analysis
+
+    u, y = _two_mode_data(np.random.default_rng(0))
+    model = PWARX(1, 1, 1, n_regions=1, segmentation="average").fit(u, y)
+    with pytest.raises(ParameterError, match=r"confidence must lie in \(0.5, 0.999999999\], got 0.9999999999999999"):
+        residual_analysis(model, u, y, confidence=0.9999999999999999)
+    assert np.isfinite(residual_analysis(model, u, y, confidence=0.999999999).band)

@@ -84,8 +84,10 @@ def register(subparsers):
 
     def confidence(text):
         value = finite_float(text)
-        if not 0.5 < value <= 1 - 1e-9:  # 1 - 1e-16: a band of +-inf called every residual white
-            raise argparse.ArgumentTypeError(f"expected a probability in (0.5, 0.999999999], got {text!r}")
+        from hwpts.identification.analysis import MAX_CONFIDENCE
+
+        if not 0.5 < value <= MAX_CONFIDENCE:  # 1 - 1e-16: a band of +-inf called every residual white
+            raise argparse.ArgumentTypeError(f"expected a probability in (0.5, {MAX_CONFIDENCE}], got {text!r}")
         return value
 
     r = subparsers.add_parser(

@@ -268,6 +268,14 @@ def _resampled(data, dt, model_dt):
     if not count <= MAX_RESAMPLED:
         raise DataError(f"--resample: the record spans {data.time[-1] - data.time[0]:.6g} s, {count:.3g} samples at the "
                         f"model's {model_dt:.6g} s (at most {MAX_RESAMPLED:.0e}); is the time column in seconds?")
+    steps = np.diff(data.time)
+    if steps.size:
+        widest = int(np.argmax(steps))
+        typical = max(float(np.median(steps)), model_dt)
+        if steps[widest] > 2.5 * typical:  # a gap, not jitter: a straight line would stand for the data there
+            raise DataError(f"--resample: the time column has a gap of {steps[widest]:.6g} s at row {widest + 1} (the "
+                            f"samples are {np.median(steps):.6g} s apart): interpolation would invent the data "
+                            f"there; split the record at the gap (--rows)")
     t = np.arange(data.time[0], data.time[-1] + 0.5 * model_dt, model_dt)
     t = t[t <= data.time[-1] + 1e-12 * abs(data.time[-1])]
     inputs = np.column_stack([np.interp(t, data.time, data.inputs[:, j]) for j in range(data.inputs.shape[1])])
@@ -878,8 +886,9 @@ def _model_and_data(args):
     output = args.output or st.output_name
     _check_signals(inputs, output)
     _check_mapped_units(model, inputs, output)
+    resamplable = getattr(model, "sample_time_", None) is not None  # (--resample needs the model's rate)
     data, dt = _load_dataset(args.data, inputs, output, args.time, args.rows,
-                             uniform=False if args.resample else None)
+                             uniform=False if args.resample else None if resamplable else True)
     data = _check_sample_time(model, data, dt, args.data, args.resample)
     st.check_length(data.n_samples, what=_selection(args, repr(str(args.data))))
     return model, data

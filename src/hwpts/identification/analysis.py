@@ -158,15 +158,18 @@ class ResidualAnalysis:
         }
 
 
+MAX_CONFIDENCE = 0.999999999  # a band's level: beyond it the band's normal quantile is inf or nearly
+
+
 def residual_analysis(model, inputs, output, lags: int = 25, confidence: float = 0.99) -> ResidualAnalysis:
     """Residual tests of a fitted ``PWARX`` on measured data (see :class:`ResidualAnalysis`).
 
-    ``lags``: the largest lag tested (samples); ``confidence``: of the band (0.5 < c < 1).
+    ``lags``: the largest lag tested (samples); ``confidence``: of the band (0.5 < c <= 0.999999999).
     """
     if isinstance(lags, bool) or not isinstance(lags, (int, np.integer)) or lags < 1:
         raise ParameterError(f"lags must be an int >= 1, got {lags!r}")
-    if not 0.5 < float(confidence) < 1:
-        raise ParameterError(f"confidence must lie in (0.5, 1), got {confidence!r}")
+    if not 0.5 < float(confidence) <= MAX_CONFIDENCE:  # 1 - 1e-16: a band of +-inf, every residual white
+        raise ParameterError(f"confidence must lie in (0.5, {MAX_CONFIDENCE}], got {confidence!r}")
     yhat = model.predict(inputs, output)
     m = model.structure_.max_lag
     y = np.asarray(output, dtype=float).ravel()
