@@ -274,6 +274,8 @@ CASES = [
       "y(k-1)", "--out", f"{W}/m.json"], "--segmentation average has a given partition"),
     (["identify", f"{W}/data.csv", *FIT, "--na", "1", "--nb", "1", "--segmentation", "threshold", "--shared-modes",
       "on", "--out", f"{W}/m.json"], "--shared-modes on: the search tries the switched segmentation"),
+    (["identify", f"{W}/data.csv", *FIT, "--regions", "3", "--shared-modes", "on", "--out", f"{W}/m.json"],
+     "--shared-modes on: the switched segmentation is tried by the search that chooses the number of regions"),
     (["identify", f"{W}/data.csv", *FIT, "--na", "1", "--nb", "1", "--nk", "1", "--segmentation", "threshold",
       "--regions", "2", "--scoring", "one-step", "--out", f"{W}/m.json"], "--scoring one-step ranks the candidates"),
     (["identify", f"{W}/data.csv", "--input", "u1", "--input", "u1", "--output", "y", "--out", f"{W}/m.json"],

@@ -505,3 +505,10 @@ def test_arrays_for_a_model_fitted_on_named_columns_warn_as_scikit_learn():
         model.predict(pd.DataFrame({"valve": u[:, 0]}), y)  # by name: no warning
         model.fit(u, y).predict(u, y)  # refitted on arrays: none either
     assert not hasattr(model, "feature_names_in_")
+
+
+def test_shared_modes_true_where_the_stage_is_not_run_is_refused():
+    u, y = two_modes()
+    for kwargs, said in ((dict(n_regions=3), "n_regions=3"), (dict(param_grid={"n_regions": [2]}), "a param_grid")):
+        with pytest.raises(ParameterError, match=f"shared_modes=True is a stage .* with {said} it is not tried"):
+            PWARXSearch(PWARX(1, 1, 1), shared_modes=True, **kwargs).fit(u, y)

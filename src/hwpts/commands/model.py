@@ -733,6 +733,11 @@ def cmd_identify(args) -> int:
                                  try_polish=try_polish, n_regions=n_regions)
         else:
             search = PWARXSearch(model, param_grid=dict(searched), progress=True, try_polish=False)
+    if args.shared_modes == "on" and (search is None or search.param_grid is not None or n_regions != "auto"):
+        # (it was ignored: the stage belongs to the adaptive search choosing the number of regions)
+        fixing = "--zero-region" if args.zero_region else f"--regions {args.regions}"
+        raise ParameterError(f"--shared-modes on: the switched segmentation is tried by the search that chooses the "
+                             f"number of regions; {fixing} fixes it (leave one of them out)")
     if search is None and args.scoring != "auto":  # (it was ignored)
         raise ParameterError(f"--scoring {args.scoring} ranks the candidates of a search; with the orders, the "
                              f"segmentation and the regions all given there is none (leave --scoring out)")

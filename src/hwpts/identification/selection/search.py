@@ -409,7 +409,8 @@ class PWARXSearch(BaseEstimator):
     shared_modes : {"auto", True, False}
         Whether the adaptive search also tries the ``switched`` segmentation (module doc, step 3):
         ``"auto"`` (default) when the gate opens, ``True`` always, ``False`` never (nor when
-        ``"switched"`` is one of ``methods``, where it is grown as the others).
+        ``"switched"`` is one of ``methods``, where it is grown as the others). ``True`` with a
+        ``param_grid`` or a fixed ``n_regions``, where the stage is not run, is refused.
     scoring : {"auto", "free_run", "one_step"}
         What ranks the candidates: the mean held-out free-run fit, or the mean held-out one-step
         fit. ``"auto"`` (default): the free run, unless no single ARX model's held-out free run
@@ -1026,6 +1027,12 @@ class PWARXSearch(BaseEstimator):
             raise ParameterError(f"PWARXSearch: scoring must be one of {list(SCORINGS)}, got {self.scoring!r}")
         if self.shared_modes not in (True, False, "auto"):
             raise ParameterError(f"PWARXSearch: shared_modes must be True, False or 'auto', got {self.shared_modes!r}")
+        if self.shared_modes is True and (self.param_grid is not None or self.n_regions != "auto"):
+            # (it was ignored: K shared modes make K or more regions, no count a user fixed, and an
+            # explicit grid is the candidates)
+            fixed = "a param_grid" if self.param_grid is not None else f"n_regions={self.n_regions!r}"
+            raise ParameterError(f"PWARXSearch: shared_modes=True is a stage of the adaptive search with the number of "
+                                 f"regions chosen; with {fixed} it is not tried (leave one of them out)")
         if self.order_ranking not in ("neighbours", "arx"):
             raise ParameterError(f"PWARXSearch: order_ranking must be 'neighbours' or 'arx', got {self.order_ranking!r}")
         self._methods()
