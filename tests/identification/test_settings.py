@@ -487,6 +487,11 @@ def test_cv_takes_a_list_of_train_test_pairs_and_checks_them():
     with pytest.raises(ParameterError, match=r"cv=\[\(array\(\[ 0, 1, .*\.\.\.: every train and test part must be "
                                              r"non-empty sample indices 0 .. 599"):
         PWARXSearch(PWARX(1, 1, 1), cv=[(idx[:400], idx[400:] + 100)]).fit(u, y)
+    for cv in ([], (pair for pair in [(idx[:400], idx[400:])])):  # min() of an empty sequence; used up by one fit
+        with pytest.raises(ParameterError, match="cv as \\(train, test\\) pairs must be a non-empty list of them"):
+            PWARXSearch(PWARX(1, 1, 1), cv=cv).fit(u, y)
+    with pytest.raises(ParameterError, match="a train part holds samples of its test block"):
+        PWARXSearch(PWARX(1, 1, 1), cv=[(idx[:500], idx[400:])]).fit(u, y)
 
 
 def test_arrays_for_a_model_fitted_on_named_columns_warn_as_scikit_learn():

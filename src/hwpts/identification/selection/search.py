@@ -598,6 +598,8 @@ class PWARXSearch(BaseEstimator):
                 if part.size == 0 or part.dtype.kind not in "iu" or part.min() < 0 or part.max() >= n:
                     raise ParameterError(f"PWARXSearch: cv={shown}: every train and test part must be non-empty "
                                          f"sample indices 0 .. {n - 1}")
+            if np.intersect1d(train, test).size:  # a model scored on its own training samples
+                raise ParameterError(f"PWARXSearch: cv={shown}: a train part holds samples of its test block")
         for train, test in splits:
             if max_lag > 0 and (test.size <= max_lag + 1 or np.any(np.diff(test) != 1)):
                 raise ParameterError(f"PWARXSearch: every test block must be contiguous and longer than "
@@ -1020,6 +1022,10 @@ class PWARXSearch(BaseEstimator):
             shown = _short(cv)
             raise ParameterError(f"PWARXSearch: cv must be None, an int >= 2 (blocks), a splitter with split() or "
                                  f"a list of (train, test) index arrays, got {shown}")
+        if cv is not None and not is_count(cv, 2) and not hasattr(cv, "split") and (
+                not isinstance(cv, (list, tuple)) or not cv):  # a generator is used up by one fit
+            raise ParameterError(f"PWARXSearch: cv as (train, test) pairs must be a non-empty list of them, got "
+                                 f"{_short(cv)}")
         if self.n_jobs is not None and (isinstance(self.n_jobs, bool) or not isinstance(self.n_jobs, (int, np.integer))
                                         or self.n_jobs == 0):
             raise ParameterError(f"PWARXSearch: n_jobs must be None or a non-zero int (-1: every core), got {self.n_jobs!r}")
