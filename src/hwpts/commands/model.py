@@ -230,10 +230,8 @@ def _mat_sample_time(path, columns) -> tuple[str, float] | None:
                                 f"expected a positive number, but it {unread[name]} (pass --time COL for a time "
                                 f"column, or --time none for the sample index)")
             continue
-        if np.size(value) != 1:
-            raise DataError(f"{str(path)!r}: the variable {name!r} is taken as the sample time in seconds; expected "
-                            f"one positive number, got {np.size(value)} values (pass --time COL for a time column, or "
-                            f"--time none for the sample index)")
+        if np.size(value) != 1:  # a signal of that name (a vector 'dt'), not a sample time
+            continue
         value = float(np.asarray(value, dtype=float).reshape(-1)[0])
         if not (np.isfinite(value) and value > 0):
             raise DataError(f"{str(path)!r}: the variable {name!r} is taken as the sample time in seconds; expected "

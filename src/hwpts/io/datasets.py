@@ -424,7 +424,27 @@ sys.stdout.buffer.write(json.dumps({"names": names, "kinds": kinds}).encode() + 
 """
 
 
+_MAT_CACHE: dict = {}  # the last .mat file read, by (path, size, mtime): mat_unread after _read_mat reads it once
+
+
 def _loadmat_isolated(p: Path) -> dict:
+    """:func:`_loadmat_child`'s result, kept for the last file read (the same file read again, for
+    the variables it skipped, started a second child process: 0.34 -> 0.7 s)."""
+    try:
+        st = p.stat()
+        key = (str(p.resolve()), st.st_size, st.st_mtime_ns, st.st_ino)
+    except OSError:
+        key = None
+    if key is not None and key in _MAT_CACHE:
+        return _MAT_CACHE[key]
+    raw = _loadmat_child(p)
+    if key is not None:
+        _MAT_CACHE.clear()
+        _MAT_CACHE[key] = raw
+    return raw
+
+
+def _loadmat_child(p: Path) -> dict:
     """``scipy.io.loadmat`` in a child process: its compiled reader can crash the process on a
     corrupt file (an unknown element type: a segmentation fault, not an exception), which must end
     in one clear line. Returns the numeric arrays by name, ``"sparse"`` for sparse variables and
