@@ -74,6 +74,8 @@ class IODataset:
     def __post_init__(self):
         time = np.asarray(self.time)
         if time.dtype.kind in "mM" and time.ndim == 1:  # time stamps or durations: seconds from the first
+            if np.any(np.isnat(time)):
+                raise DataError(f"time has a missing stamp (NaT) at row {int(np.argmax(np.isnat(time)))}")
             start = time[0] if time.size and time.dtype.kind == "M" else np.timedelta64(0, "ns")
             time = (time - start).astype("timedelta64[ns]").astype(np.int64) / 1e9
         time = dense_real(time, "time")  # complex or text refused, not cast
@@ -200,8 +202,9 @@ class IODataset:
         else:
             if isinstance(sample_time, bool) or not isinstance(sample_time, (int, float, np.integer, np.floating)) \
                     or not (np.isfinite(sample_time) and sample_time > 0):
-                raise DataError(f"sample_time must be a positive number of seconds (the data have no time column "
-                                f"{time_name!r}), got {sample_time!r}")
+                where = "no time column" if time_name is None else f"no time column {time_name!r}"
+                raise DataError(f"sample_time must be a positive number of seconds (the data have {where}), got "
+                                f"{sample_time!r}")
             time = np.arange(n) * float(sample_time)
         inputs = np.column_stack([dense_real(columns[c], repr(c)) for c in input_names])
         return cls(time, inputs, columns[output_name], tuple(input_names), output_name)

@@ -38,6 +38,8 @@ __all__ = ["RegressorStructure", "as_order_tuple"]
 
 def as_order_tuple(value, n_inputs: int, name: str, minimum: int) -> tuple[int, ...]:
     """An order given as an int (same for every input) or one int per input, as a tuple."""
+    if isinstance(value, np.ndarray) and value.ndim == 0:  # np.array(2): its number
+        value = value.item()
     if isinstance(value, (int, np.integer)) and not isinstance(value, bool):
         values = (int(value),) * n_inputs
     else:

@@ -273,7 +273,8 @@ def _read_csv_python(p: Path, delimiter: str = ",", columns=None) -> dict[str, n
             try:
                 values[k, j] = plain_float(cell)
             except ValueError:
-                comma = re.fullmatch(r"[+-]?\d*,\d+([eE][+-]?\d+)?", cell.strip())  # a European file's 0,5
+                # a European file's 0,5 or 12,75 (not 1,000: a thousands separator as likely)
+                comma = re.fullmatch(r"[+-]?(0?,\d+|\d+,(\d{1,2}|\d{4,}))([eE][+-]?\d+)?", cell.strip())
                 raise DataError(f"{str(p)!r} line {i}, column {header[j]!r}: expected a number, "
                                 f"got {cell.strip()!r}"
                                 f"{' (a decimal comma: write the numbers with a point, 0.5)' if comma else ''}") from None
