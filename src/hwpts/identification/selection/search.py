@@ -519,8 +519,8 @@ class PWARXSearch(BaseEstimator):
             if unknown:
                 raise ParameterError(f"PWARXSearch: orders has unknown keys {sorted(unknown)}; valid are {list(ORDER_KEYS)}")
             # a single value is one candidate ({"output_order": 2}: 'int' object is not iterable)
-            grid = {k: v if isinstance(v, str) else tuple(v) if np.ndim(v) > 0 and hasattr(v, "__iter__") else (v,)
-                    for k, v in self.orders.items()}
+            grid = {k: v if isinstance(v, str) else (v.item(),) if isinstance(v, np.ndarray) and v.ndim == 0
+                    else tuple(v) if hasattr(v, "__iter__") else (v,) for k, v in self.orders.items()}
         else:
             raise ParameterError(f"PWARXSearch: orders must be None, 'auto' or a dict of lists, got {self.orders!r}")
         if isinstance(grid.get("input_delay"), str):
