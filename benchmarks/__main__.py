@@ -15,6 +15,11 @@ def main(argv=None) -> int:
     names = sorted(
         m.name for m in pkgutil.iter_modules([str(Path(__file__).parent)]) if m.name.startswith("bench_")
     )
+    if "-h" in argv or "--help" in argv:  # (it ran every benchmark)
+        print(f"usage: python -m benchmarks [NAME ...] [--option=value ...]\n\n{__doc__.strip()}\n\n"
+              f"benchmarks: {', '.join(n.removeprefix('bench_') for n in names)}; each module's docstring gives "
+              f"its options (python -c 'import benchmarks.bench_zoo as b; print(b.__doc__)')")
+        return 0
     wanted = [a for a in argv if not a.startswith("-")] or names
     unknown = [w for w in wanted if w not in names and f"bench_{w}" not in names]
     if unknown:
