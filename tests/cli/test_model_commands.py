@@ -756,6 +756,6 @@ def test_a_mat_sample_time_that_is_no_number_is_refused(tmp_path, capsys, ts, sa
     savemat(path, {"u": rng.random(200), "y": rng.random(200), "Ts": ts})
     out = tmp_path / "m.json"
     _expect_error(capsys, ["identify", str(path), "--input", "u", "--output", "y", "--na", "1", "--nb", "1",
-                           "--out", str(out)], f"the variable 'Ts' is taken as the sample time in seconds; expected", out)
+                           "--out", str(out)], "the variable 'Ts' is taken as the sample time in seconds; expected", out)
     main(["identify", str(path), "--input", "u", "--output", "y", "--na", "1", "--nb", "1", "--out", str(out)])
     assert said in capsys.readouterr().err

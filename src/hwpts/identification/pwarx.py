@@ -720,8 +720,6 @@ def frame_sample_time(X, breaks=(), remedy: str = FRAME_REMEDY) -> float | None:
     an IODataset's time is: read by position, the lags would span the gap. With ``breaks`` (the
     rows where the record restarts) only the steps within each stretch must be uniform, and agree.
     An unsorted index is refused before (:func:`_check_index`)."""
-    from hwpts.dataset import uniform_sample_time
-
     time = frame_time(X)
     if time is None or time.size < 2:
         return None
