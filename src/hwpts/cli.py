@@ -15,6 +15,7 @@ import shlex
 import signal
 import sys
 import threading
+import warnings
 from collections.abc import Sequence
 
 from hwpts import __version__
@@ -169,7 +170,14 @@ def _run(argv: Sequence[str] | None) -> int:
         args.command_line = shlex.join(["hwpts", *given])
         before = _outputs(args)
         _check_outputs(args)
-        status = int(args.handler(args) or EXIT_OK)
+        with warnings.catch_warnings(record=True) as caught:
+            # a library warning is one line after a run that succeeded (Python's two lines, with a
+            # source path, came before the error line of one that failed: three lines for one error)
+            warnings.simplefilter("default")
+            status = int(args.handler(args) or EXIT_OK)
+        for message in dict.fromkeys(_one_line(f"hwpts: warning: {w.message}") for w in caught
+                                     if not issubclass(w.category, (DeprecationWarning, PendingDeprecationWarning))):
+            print(message, file=sys.stderr)
         _SETTLED.set()  # a signal from here on arrives after the run: its status stands
     except BaseException as error:
         if isinstance(error, KeyboardInterrupt) or (_INTERRUPTED.is_set() and isinstance(error, Exception)):

@@ -416,6 +416,14 @@ CASES = [
     (["reproduce", "--seed", "abc", "--out", f"{W}/r"], "--seed"),
     # --- control
     (["control", "run", "--scenario", "hurricane", "--model", f"{W}/model.json", "--out", f"{W}/c"], "--scenario"),
+    # found by a review, 2026-11-27: a play of 1.29 V left 0.02 V of valve travel (every loop lost the
+    # speed, exit 0); --model-sample-time without --model and --workers beside --scheduler were ignored
+    (["control", "run", "--scenario", "pump-step", "--model", f"{W}/model.json", "--hysteresis-width", "1.29",
+      "--out", f"{W}/c"], "--hysteresis-width: expected a half-width in 0-0.8 V"),
+    (["control", "run", "--scenario", "pump-step", "--model-sample-time", "0.013", "--out", f"{W}/c"],
+     "--model-sample-time gives a model file's sample period"),
+    (["control", "study", "--plants", "1", "--seeds", "1", "--scheduler", "tcp://127.0.0.1:1", "--workers", "2",
+      "--out", f"{W}/c"], "--workers sizes the local cluster"),
     (["control", "run", "--scenario", "pump-step", "--model", f"{W}/missing.json", "--out", f"{W}/c"], "missing.json"),
     (["control", "run", "--scenario", "pump-step", "--model", f"{W}/model.json", "--out", f"{W}/c"],
      "--model '{ws}/model.json': the model's inputs must be the valve voltage"),

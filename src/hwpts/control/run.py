@@ -12,20 +12,24 @@ from hwpts.control.loop import REACHABLE_HOLD_S, reachable_mask, run_loop
 from hwpts.control.metrics import compute_metrics
 from hwpts.control.model import ModelBank
 from hwpts.control.scenarios import SAMPLE_TIME_S, build_scenario
-from hwpts.errors import ParameterError
+from hwpts.errors import DataError, ParameterError
 
 SCHEMA = "hwpts.control/1"
 SETPOINT_RANGE_RPM = (300.0, 1400.0)
 """Set-points the test bed can hold at some pump speed of the turbine's range [r/min]."""
 
 
-def check_setpoint(bank: ModelBank, setpoint: float, output_range=None) -> None:
+def check_setpoint(bank: ModelBank, setpoint: float, output_range=None, argument: str = "--setpoint") -> None:
     """Refuse a set-point [r/min] outside the documented range or outside what the model was identified on."""
     lo, hi = SETPOINT_RANGE_RPM
     if output_range is not None:
+        if output_range[1] < lo or output_range[0] > hi:  # (said as "a speed in 300-25 r/min")
+            raise DataError(f"--model: the model was identified on outputs of {output_range[0]:.4g} to "
+                            f"{output_range[1]:.4g}, none within the test bed's set-points {lo:.0f}-{hi:.0f} r/min; "
+                            f"is its output motor A's speed in r/min?")
         lo, hi = max(lo, output_range[0]), min(hi, output_range[1])
     if not (math.isfinite(setpoint) and lo <= setpoint <= hi):
-        raise ParameterError(f"--setpoint: expected a speed in {lo:.0f}-{hi:.0f} r/min (within the test bed's reach "
+        raise ParameterError(f"{argument}: expected a speed in {lo:.0f}-{hi:.0f} r/min (within the test bed's reach "
                              f"and the model's training range), got {setpoint:g}")
 
 
