@@ -1,7 +1,7 @@
 """Numbers written as text, read by one rule wherever hwpts reads them (command-line arguments,
 CSV cells, hyperplanes). Python's ``float`` and ``int`` also read ``"1_000"`` as 1000 and
 non-ASCII digits such as ``"\u0663"`` (an Arabic-Indic three) as 3; no CSV writer or command line
-hwpts serves means either, so both are refused here (``ValueError``)."""
+hwpts serves means either, so both are refused here (``ValueError``). And file names shown as text."""
 
 from __future__ import annotations
 
@@ -24,3 +24,9 @@ def plain_int(text) -> int:
     if not _INTEGER.fullmatch(str(text)):
         raise ValueError(text)
     return int(text)
+
+
+def shown_text(text: str) -> str:
+    """``text`` as it can be written and drawn: bytes of a file name that are not UTF-8 (kept by
+    Python as surrogates, which a UTF-8 writer and matplotlib's font renderer refuse) as ``\\xNN``."""
+    return text.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")

@@ -232,16 +232,16 @@ def study_command(args) -> int:
     bank = _bank(args, doc, sample_time)  # refuse a model a controller cannot be designed from, before any work
     # the checks control run makes, before the cluster starts (a Dask worker's error said "choose a
     # reachable set-point", which study has no option for)
-    from hwpts.control.controllers.pi import UnreachableSetpoint, nominal_design
+    from hwpts.control.controllers.pi import NOMINAL_PUMP_RPM, UnreachableSetpoint, nominal_design
     from hwpts.control.run import check_setpoint
     from hwpts.control.scenarios import SETPOINT_RPM
 
     check_setpoint(bank, SETPOINT_RPM, doc["training"]["output_range"], argument="the study's set-point")
     try:
-        nominal_design(bank, SETPOINT_RPM, 700.0)  # the baseline pi's design point
-    except UnreachableSetpoint as error:
-        raise DataError(f"--model {str(args.model)!r}: {error.args[0].split(';')[0]}, where the baseline pi is "
-                        f"designed") from None
+        nominal_design(bank, SETPOINT_RPM, NOMINAL_PUMP_RPM)  # the baseline pi's design point
+    except UnreachableSetpoint:
+        raise DataError(f"--model {str(args.model)!r}: the model has no steady state at {SETPOINT_RPM:g} r/min with "
+                        f"the pump at {NOMINAL_PUMP_RPM:g} r/min, where the baseline pi is designed") from None
     result = run_study(doc, sample_time, half_width, args.plants, args.seeds, names, args.scenario, args.seed,
                        args.scheduler, args.duration, progress=sys.stderr.isatty(), n_workers=args.workers)
     summary = {"schema": STUDY_SCHEMA, "scenario": args.scenario, "plants": args.plants, "seeds": args.seeds,

@@ -192,15 +192,15 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None, uni
     except DataError as error:  # the hint where the time column is what the error is about
         about_time = str(error).startswith("time ") or repr(tname) in str(error) or "'time'" in str(error)
         raise DataError(f"{str(path)!r}: {error}{hint if about_time else ''}") from None
+    remedy = "resample the data, or split the record at the gap"
+    if uniform is None:  # a command that resamples when asked: say so
+        remedy += ", or pass --resample to interpolate it onto the model's rate"
     try:
-        dt = _sample_time(data, path, tname) if timed else None
-    except DataError as error:
-        if uniform is False and "not uniformly sampled" in str(error):
-            dt = math.nan  # jitter or gaps: a time axis all the same, to be resampled (--resample)
-        elif uniform is None:  # a command that resamples when asked: say so
-            raise DataError(f"{error}, or pass --resample to interpolate it onto the model's rate{hint}") from None
-        else:
+        dt = _sample_time(data, path, tname, remedy) if timed else None
+    except DataError as error:  # (the only one: a time axis that is not uniform)
+        if uniform is not False:
             raise DataError(f"{error}{hint}") from None
+        dt = math.nan  # jitter or gaps: a time axis all the same, to be resampled (--resample)
     if period is not None:
         name, value = period
         if dt is None:
@@ -246,9 +246,10 @@ def _selection(args, name: str) -> str:
     return name + (f" (--rows {args.rows})" if args.rows else "")
 
 
-def _sample_time(data, path, tname) -> float | None:
-    """The data's sample period [s] from its time column; a non-uniform time axis is refused."""
-    return data.uniform_sample_time(f"{str(path)!r}: the time column {tname!r}")
+def _sample_time(data, path, tname, remedy: str) -> float | None:
+    """The data's sample period [s] from its time column; a non-uniform time axis is refused
+    (saying ``remedy``)."""
+    return data.uniform_sample_time(f"{str(path)!r}: the time column {tname!r}", remedy)
 
 
 SAMPLE_TIME_TOLERANCE = 0.01  # relative difference of sample times treated as equal

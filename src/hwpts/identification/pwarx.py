@@ -330,30 +330,7 @@ class PWARX(BaseEstimator):
         structure = RegressorStructure.create(*self.given_orders(), n_inputs, self.constant, names, oname,
                                               self.output_powers, *power_scaling(yy))
         structure.check_length(yy.shape[0])
-        # the signals the regressor holds (an input of order 0 is not checked: it is not used)
-        used = [(name, values) for name, values, nb in zip(names, u.T, structure.nb) if nb > 0]
-        for name, values in [*used, (structure.output_name, yy)]:
-            largest = float(np.max(np.abs(values)))
-            if 0 < largest < MIN_ABS_SCALE:  # its least squares gave zero gains, with a warning only
-                raise DataError(f"signal {name!r} holds no value larger than {largest:.3g} in magnitude, below "
-                                f"{MIN_ABS_SCALE:.0e}: too small to fit; rescale it")
-            spread = float(np.ptp(values))
-            if spread > 0 and largest > MAX_OFFSET_RATIO * spread:
-                # the model works on the raw values: pick_and_place's output + 1e12 (25 units around
-                # 1e12) fitted a free run of 45.9 % for 79.2 %, + 1e15 a one-step fit of 53 % for 99.9 %
-                level = float(np.median(values))
-                raise DataError(f"signal {name!r} varies by {spread:.3g} around {level:.6g}: an offset "
-                                f"{largest / spread:.1e} times its variation leaves the model too few digits; "
-                                f"subtract it first ({name} - {level:.6g})")
-        for j, name in enumerate(names):
-            if structure.nb[j] > 0 and np.ptp(u[:, j]) == 0:
-                raise DataError(
-                    f"input {name!r} is constant ({u[0, j]:.6g}) in the training data: it carries no "
-                    f"information and makes the least squares singular; drop it or use richer data"
-                )
-        if np.ptp(yy) == 0:
-            raise DataError(f"output {structure.output_name!r} is constant in the training data; "
-                            f"there is nothing to identify")
+        _check_signals_fit(structure, u, yy)
         segmenter = self._segmenter()
         rng = np.random.default_rng(self.random_state)
         X_reg, target = structure.build(u, yy)
@@ -790,6 +767,31 @@ def check_fit_arguments(sample_time, units, output_name) -> None:
         raise ParameterError(f"units must be a dict {{signal name: unit}} or None, got {units!r}")
     if output_name is not None and (not isinstance(output_name, str) or not output_name):
         raise ParameterError(f"output_name must be a non-empty string, got {output_name!r}")
+
+
+def _check_signals_fit(structure, u, yy) -> None:
+    """The signals the regressor holds (an input of order 0 is not used, so not checked) can be
+    fitted: none constant, none whose values all lie below :data:`MIN_ABS_SCALE` (its least squares
+    gave zero gains, with a warning only), none whose offset is more than :data:`MAX_OFFSET_RATIO`
+    times its variation (the model works on the raw values: pick_and_place's output + 1e12, 25 units
+    around 1e12, fitted a free run of 45.9 % for 79.2 %; + 1e15 a one-step fit of 53 % for 99.9 %)."""
+    used = [(name, values) for name, values, nb in zip(structure.input_names, u.T, structure.nb) if nb > 0]
+    for j, (name, values) in enumerate([*used, (structure.output_name, yy)]):
+        spread = float(np.ptp(values))
+        if spread == 0 and j < len(used):
+            raise DataError(f"input {name!r} is constant ({values[0]:.6g}) in the training data: it carries no "
+                            f"information and makes the least squares singular; drop it or use richer data")
+        if spread == 0:
+            raise DataError(f"output {name!r} is constant in the training data; there is nothing to identify")
+        largest = float(np.max(np.abs(values)))
+        if largest < MIN_ABS_SCALE:
+            raise DataError(f"signal {name!r} holds no value larger than {largest:.3g} in magnitude, below "
+                            f"{MIN_ABS_SCALE:.0e}: too small to fit; rescale it")
+        if largest > MAX_OFFSET_RATIO * spread:
+            level = float(np.median(values))
+            raise DataError(f"signal {name!r} varies by {spread:.3g} around {level:.6g}: an offset "
+                            f"{largest / spread:.1e} times its variation leaves the model too few digits; "
+                            f"subtract it first ({name} - {level:.6g})")
 
 
 def signal_names(names, output_name, n_inputs) -> tuple[tuple[str, ...], str]:

@@ -339,7 +339,7 @@ def validate_inputs(inputs, n_inputs: int | None = None) -> np.ndarray:
         raise DataError(f"inputs must be 2-D (n_samples, n_inputs); got shape {u.shape}")
     if n_inputs is not None and u.shape[1] != n_inputs:
         raise DataError(f"expected {n_inputs} input columns, got {u.shape[1]}")
-    _check_values("inputs", u)
+    check_values("inputs", u)
     return u
 
 
@@ -351,12 +351,13 @@ def validate_signals(inputs, output, n_inputs: int | None = None) -> tuple[np.nd
         raise DataError(f"output must be 1-D; got shape {y.shape}")
     if u.shape[0] != y.shape[0]:
         raise DataError(f"inputs have {u.shape[0]} rows but output has {y.shape[0]}")
-    _check_values("output", y)
+    check_values("output", y)
     return u, y
 
 
-def _check_values(label: str, arr: np.ndarray) -> None:
-    """Every value finite and within +-MAX_ABS_VALUE (else a DataError naming the first row)."""
+def check_values(label: str, arr: np.ndarray) -> None:
+    """Every value finite and within +-MAX_ABS_VALUE (else a DataError naming the first row): the
+    signals of a fit, and the rows a segmenter or the partition learner is given."""
     bad = ~np.isfinite(arr)
     if bad.any():
         row = int(np.argwhere(bad.reshape(arr.shape[0], -1))[0, 0])

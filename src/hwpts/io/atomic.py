@@ -13,6 +13,7 @@ import threading
 from pathlib import Path
 
 from hwpts.errors import DataError
+from hwpts.text import shown_text
 
 
 INTERRUPTED = threading.Event()
@@ -83,8 +84,8 @@ def check_utf8_path(path: str | os.PathLike, what: str = "--out") -> None:
     try:
         text.encode("utf-8")
     except UnicodeEncodeError:
-        shown = text.encode("utf-8", "surrogateescape").decode("ascii", "backslashreplace")
-        raise DataError(f"{what} '{shown}': the path holds bytes that are not UTF-8; give a UTF-8 path") from None
+        raise DataError(f"{what} '{shown_text(text)}': the path holds bytes that are not UTF-8; give a UTF-8 "
+                        f"path") from None
 
 
 def process_alive(pid: int) -> bool:

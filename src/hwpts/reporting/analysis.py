@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from hwpts.reporting.figures import _png, _pyplot, plain_text
+from hwpts.reporting.figures import _png, _pyplot
+from hwpts.text import shown_text
 
 __all__ = ["validation_figure", "residual_figure"]
 
@@ -52,7 +53,7 @@ def validation_figure(time, measured, simulated, regions, *, n_initial: int, out
     ax.set_xlabel(f"time [{time_unit}]" if time_unit else "sample")
     ax.grid(alpha=0.3)
     if title:
-        fig.suptitle(plain_text(title), fontsize=10)
+        fig.suptitle(shown_text(title), fontsize=10)
     return _png(fig)
 
 
@@ -89,5 +90,5 @@ def residual_figure(analysis, *, output_name: str = "y", unit: str | None = None
     axes[-1].set_xlabel("lag [samples]")
     rms = float(np.sqrt(np.mean(np.asarray(analysis.residuals) ** 2)))
     head = f"one-step residuals: {analysis.n_samples} samples, rms {rms:.4g}" + (f" {unit}" if unit else "")
-    fig.suptitle(f"{plain_text(title)}\n{head}" if title else head, fontsize=10)
+    fig.suptitle(f"{shown_text(title)}\n{head}" if title else head, fontsize=10)
     return _png(fig)

@@ -27,12 +27,6 @@ def _pyplot():
     return plt
 
 
-def plain_text(text: str) -> str:
-    """``text`` as matplotlib can draw it: bytes of a file name that are not UTF-8 (kept by Python
-    as surrogates, which the font renderer refuses with a TypeError) as ``\\xNN`` escapes."""
-    return text.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
-
-
 def _png(fig) -> bytes:
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=110, bbox_inches="tight", metadata={"Software": None})

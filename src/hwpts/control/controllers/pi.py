@@ -13,6 +13,9 @@ CLOSED_LOOP_TIME_S = 0.05
 """tau_c of the SIMC rule for the baseline [s]: the best of 0.05, 0.08, 0.10 and 0.15 s on class A
 turbulence (RMS error 0.62, 0.76, 0.85, 1.08 % over 200 s), so the baseline is a tuned one."""
 
+NOMINAL_PUMP_RPM = 700.0
+"""The pump speed the baseline's gains and feedforward are designed at [r/min]."""
+
 SPEED_FILTER_S = 0.02
 """Low-pass on the measured speed against sensor noise [s]."""
 
@@ -46,7 +49,8 @@ class PIController(Controller):
 
     name = "pi"
 
-    def __init__(self, bank: ModelBank, half_width: float, inverse: bool = True, nominal_pump: float = 700.0,
+    def __init__(self, bank: ModelBank, half_width: float, inverse: bool = True,
+                 nominal_pump: float = NOMINAL_PUMP_RPM,
                  sample_time: float = 0.01, closed_loop_time: float = CLOSED_LOOP_TIME_S):
         super().__init__(sample_time)
         self.bank = bank

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 
 from hwpts.control.controllers.base import Controller, HysteresisInverse, LowPass, ModelRateHistory, PILaw
-from hwpts.control.controllers.pi import SPEED_FILTER_S, region_gains
+from hwpts.control.controllers.pi import NOMINAL_PUMP_RPM, SPEED_FILTER_S, region_gains
 from hwpts.control.controllers.play import AdaptiveInverse, PlayWidthEstimator
 from hwpts.control.model import ModelBank
 
@@ -36,7 +36,8 @@ class ScheduledController(Controller):
     name = "scheduled"
     has_modes = True
 
-    def __init__(self, bank: ModelBank, half_width: float, inverse: bool = True, nominal_pump: float = 700.0,
+    def __init__(self, bank: ModelBank, half_width: float, inverse: bool = True,
+                 nominal_pump: float = NOMINAL_PUMP_RPM,
                  sample_time: float = 0.01, closed_loop_time: float = CLOSED_LOOP_TIME_S, bumpless: bool = True,
                  adapt_width: bool = True):
         super().__init__(sample_time)

@@ -140,10 +140,13 @@ class PartitionLearner(BaseEstimator):
                             f"{X.shape}, {y.shape} and {raw.shape}")
         if X.shape[0] == 0:
             raise DataError("PartitionLearner: X and y must hold at least one row")
-        for label, values in (("X", X), ("y", y)):
-            if not np.all(np.isfinite(values)):
-                row = int(np.argwhere(~np.isfinite(values.reshape(values.shape[0], -1)))[0, 0])
-                raise DataError(f"PartitionLearner: {label} has a non-finite value (NaN or inf) at row {row}")
+        from hwpts.identification.regressors import check_values
+
+        try:
+            check_values("X", X)
+            check_values("y", y)
+        except DataError as error:
+            raise DataError(f"PartitionLearner: {error}") from None
         if raw.dtype.kind not in "iu" and not (raw.dtype.kind in "bf" and np.array_equal(raw, np.round(raw))):
             raise DataError(f"PartitionLearner: labels must be whole numbers 0 .. {s - 1}, got values of type "
                             f"{raw.dtype}")

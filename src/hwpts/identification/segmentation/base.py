@@ -78,16 +78,15 @@ class Segmenter(BaseEstimator):
         their targets ``y`` (n,), finite, and ``rng`` a numpy ``Generator`` (an int or ``None``
         seeds one, as scikit-learn's ``random_state``); else one line naming the argument."""
         from hwpts.dataset import dense_real
+        from hwpts.identification.regressors import check_values
 
         X, y = dense_real(X, "X"), dense_real(y, "y")
         if X.ndim != 2:
             raise DataError(f"X must be the regressor rows, shape (n, p); got shape {X.shape}")
         if y.ndim != 1 or y.shape[0] != X.shape[0]:
             raise DataError(f"y must be the targets of X's {X.shape[0]} rows, shape ({X.shape[0]},); got shape {y.shape}")
-        for label, values in (("X", X), ("y", y)):
-            if not np.all(np.isfinite(values)):
-                row = int(np.argwhere(~np.isfinite(values.reshape(values.shape[0], -1)))[0, 0])
-                raise DataError(f"{label} has a non-finite value (NaN or inf) at row {row}")
+        check_values("X", X)
+        check_values("y", y)
         if not isinstance(rng, np.random.Generator):
             if rng is not None and (isinstance(rng, bool) or not isinstance(rng, (int, np.integer)) or rng < 0):
                 raise ParameterError(f"rng must be a numpy Generator, an int >= 0 or None, got {rng!r}")

@@ -600,7 +600,6 @@ class PWARXSearch(BaseEstimator):
                                          f"sample indices 0 .. {n - 1}")
             if np.intersect1d(train, test).size:  # a model scored on its own training samples
                 raise ParameterError(f"PWARXSearch: cv={shown}: a train part holds samples of its test block")
-        for train, test in splits:
             if max_lag > 0 and (test.size <= max_lag + 1 or np.any(np.diff(test) != 1)):
                 raise ParameterError(f"PWARXSearch: every test block must be contiguous and longer than "
                                      f"{max_lag + 1} samples (the initial conditions)")
