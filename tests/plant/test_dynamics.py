@@ -53,3 +53,19 @@ def test_five_poles_three_zeros(v, w):
     assert poles.size == 5
     assert np.all(poles.real < 0), "the operating point must be stable"
     assert zeros.size == 3
+
+
+def test_a_stopped_pump_does_not_turn_backwards_and_its_jacobian_says_so():
+    # docs/plant.md 2.9: w_p = max(w_p,cmd - K_droop D_p P_p, 0); at a command of 100 r/min and
+    # 7 MPa the droop alone would give about -475 r/min
+    p = PlantParameters.test_bed()
+    x = np.array([7.0e6, 3.0e6, 0.9e6, 50.0, 300.0])
+    h, wp = float(spool_position(2.0, p)), rpm_to_rad_s(100.0)
+    flow = rhs(p, x, h, wp)[0] * p.pump_chamber_volume / p.bulk_modulus
+    stopped = rhs(p, x, h, 0.0)[0] * p.pump_chamber_volume / p.bulk_modulus
+    assert flow == pytest.approx(stopped)  # no pump flow either way once the droop reaches the command
+    jac, _ = jacobian(p, x, h, wp)
+    step = 10.0
+    e = np.array([step, 0, 0, 0, 0])
+    fd = (rhs(p, x + e, h, wp) - rhs(p, x - e, h, wp)) / (2 * step)
+    assert np.allclose(jac[:, 0], fd, rtol=1e-5, atol=1e-9 * np.abs(fd).max())

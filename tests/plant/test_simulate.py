@@ -131,3 +131,16 @@ def test_a_long_hold_is_cut_into_pieces_and_the_rows_kept():
     held = np.searchsorted(t, fine, side="right") - 1  # the row whose inputs hold at each fine instant
     ref = simulate_plant(PlantParameters.paper(), fine, v[held], w[held])
     np.testing.assert_allclose(sim.motor_a_speed_rpm, ref.motor_a_speed_rpm[rows], rtol=1e-4)
+
+
+def test_an_abrupt_stop_keeps_the_pump_forward_and_the_pressures_above_vacuum():
+    # docs/plant.md 2.8-2.9: full flow to motor B (10 V, 3000 r/min), then valve and pump command to 0:
+    # the make-up valves feed the chambers that motor B and motor A empty as they coast (a gain of 1e-9
+    # let P_B fall to -574 kPa, below vacuum) and the pump stops instead of running at -577 r/min
+    p = PlantParameters.test_bed()
+    t = np.arange(0, 6.0, 0.01)
+    on = t < 2.0
+    sim = simulate_plant(p, t, np.where(on, 10.0, 0.0), np.where(on, 3000.0, 0.0))
+    assert sim.motor_b_speed_rpm[on].max() > 4000
+    assert sim.pump_speed_rpm.min() >= 0.0
+    assert sim.state[:, :3].min() > -1e3  # Pa gauge: above vacuum by two orders of magnitude

@@ -57,8 +57,18 @@ _WSYNC = _I["generator_synchronous_speed"]
 
 @numba.njit(cache=True)
 def pump_speed_actual(pump_pressure, pump_speed_command, p):
-    """Pump speed after prime-mover droop: w_p = w_p,cmd - K_droop * D_p * P_p [rad/s] (docs/plant.md 2.9)."""
-    return pump_speed_command - p[_KDR] * p[_DP] * pump_pressure
+    """Pump speed after prime-mover droop: w_p = max(w_p,cmd - K_droop * D_p * P_p, 0) [rad/s]
+    (docs/plant.md 2.9): the turbine-driven pump slows under load but does not turn backwards (a
+    command of 0 at 7 MPa gave -577 r/min, the pump motoring the line empty)."""
+    return np.maximum(pump_speed_command - p[_KDR] * p[_DP] * pump_pressure, 0.0)
+
+
+@numba.njit(cache=True)
+def pump_speed_slope(pump_pressure, pump_speed_command, p):
+    """d w_p / d P_p of :func:`pump_speed_actual` [(rad/s)/Pa]: the droop while the pump turns, 0 once stopped."""
+    if pump_speed_command - p[_KDR] * p[_DP] * pump_pressure > 0.0:
+        return -p[_KDR] * p[_DP]
+    return 0.0
 
 
 @numba.njit(cache=True)
@@ -80,8 +90,7 @@ def rhs_into(x, h, wp_cmd, p, dx):
     area_b = p[_AMAX] * frac + p[_ALEAK]
     qa = c * area_a * orifice_shape(pp - pa, p[_PCR], eps)
     qb = c * area_b * orifice_shape(pp - pb - p[_POB], p[_PCR], eps)
-    wp = wp_cmd - p[_KDR] * p[_DP] * pp
-    qp = p[_DP] * wp - p[_CSP] * pp
+    qp = p[_DP] * pump_speed_actual(pp, wp_cmd, p) - p[_CSP] * pp
     qrv = p[_KRV] * smooth_max0(pp - p[_PRV], eps)
     kmu = p[_KMU]
     dx[0] = p[_BETA] / p[_VP] * (qp - qa - qb - qrv + kmu * smooth_max0(-pp, MAKEUP_SMOOTHING_PA))
@@ -112,7 +121,7 @@ def jacobian_into(x, h, wp_cmd, p, jac, dfdh):
     dqa_dh = -c * p[_AMAX] / p[_HMAX] * orifice_shape(dpa, pcr, eps)
     dqb_dh = c * p[_AMAX] / p[_HMAX] * orifice_shape(dpb, pcr, eps)
     kmu = p[_KMU]
-    dqp_dpp = -p[_DP] * p[_KDR] * p[_DP] - p[_CSP]
+    dqp_dpp = p[_DP] * pump_speed_slope(pp, wp_cmd, p) - p[_CSP]
     dqrv_dpp = p[_KRV] * smooth_max0_derivative(pp - p[_PRV], eps)
     kp = p[_BETA] / p[_VP]
     ka = p[_BETA] / p[_VA]

@@ -434,8 +434,7 @@ class PlantStepper:
 
     def pump_speed_rpm(self, pump_speed_command_rpm: float) -> float:
         """The actual pump speed [r/min] at the present pump pressure (after droop)."""
-        p = self._p
-        return float(pump_speed_command_rpm - p[_I["droop_gain"]] * p[_I["pump_displacement"]] * self._z[0]
+        return float(pump_speed_actual.py_func(self._z[0], pump_speed_command_rpm * RAD_S_PER_RPM, self._p)
                      * RPM_PER_RAD_S)
 
     def set_load_factor(self, factor: float) -> None:

@@ -21,7 +21,7 @@ import numba
 import numpy as np
 
 from hwpts.errors import ParameterError, SimulationError
-from hwpts.plant.dynamics import N_STATES, pump_speed_actual
+from hwpts.plant.dynamics import N_STATES, pump_speed_actual, pump_speed_slope
 from hwpts.plant.parameters import PARAMETER_INDEX as _I
 from hwpts.plant.parameters import PlantParameters
 from hwpts.plant.valve import (
@@ -41,7 +41,6 @@ BRANCHES = ("none", "up", "down")
 _AUX_OPENING_PRESSURE = _I["aux_opening_pressure"]
 _COULOMB_SPEED_WIDTH = _I["coulomb_speed_width"]
 _DISCHARGE_COEFFICIENT = _I["discharge_coefficient"]
-_DROOP_GAIN = _I["droop_gain"]
 _LEAK_AREA = _I["leak_area"]
 _MAKEUP_GAIN = _I["makeup_gain"]
 _MAX_ORIFICE_AREA = _I["max_orifice_area"]
@@ -162,10 +161,9 @@ def _pump_balance(pp, h, wp_cmd, p, speeds, work):
     dqb = out[3] + out[4] * (-out[2] / out[1])
     speeds[0] = wa
     speeds[1] = wb
-    wp = wp_cmd - p[_DROOP_GAIN] * p[_PUMP_DISPLACEMENT] * pp
-    qp = p[_PUMP_DISPLACEMENT] * wp - p[_PUMP_LEAKAGE] * pp
+    qp = p[_PUMP_DISPLACEMENT] * pump_speed_actual(pp, wp_cmd, p) - p[_PUMP_LEAKAGE] * pp
     qrv = p[_RELIEF_GAIN] * smooth_max0(pp - p[_RELIEF_PRESSURE], eps)
-    work[0] = (-p[_PUMP_DISPLACEMENT] * p[_DROOP_GAIN] * p[_PUMP_DISPLACEMENT] - p[_PUMP_LEAKAGE]
+    work[0] = (p[_PUMP_DISPLACEMENT] * pump_speed_slope(pp, wp_cmd, p) - p[_PUMP_LEAKAGE]
                - kmu * smooth_max0_derivative(-pp, MAKEUP_SMOOTHING_PA) - dqa - dqb
                - p[_RELIEF_GAIN] * smooth_max0_derivative(pp - p[_RELIEF_PRESSURE], eps))
     return qp + kmu * smooth_max0(-pp, MAKEUP_SMOOTHING_PA) - qa - qb - qrv
