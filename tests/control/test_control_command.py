@@ -32,6 +32,12 @@ def test_run_writes_the_contract(tmp_path, paper_model_file, paper_model_doc, ca
     assert s["controllers"]["pi"]["mode_switches_per_min"] is None
     for name in ("pi", "scheduled", "scheduled-no-inverse"):
         assert (out / "data" / f"{name}.csv").exists()
+    # the region column numbers regions as the summary and the model file do (1-based); 0: none (pi)
+    from hwpts.io.datasets import read_table
+
+    assert set(read_table(out / "data" / "pi.csv", ["region"])["region"]) == {0.0}
+    used = {r["region"] for r in s["model"]["regions"] if r["used_for_control"]}
+    assert set(read_table(out / "data" / "scheduled.csv", ["region"])["region"]) <= used
     assert (out / "figures" / "setpoint-step.png").exists()
     html = (out / "report.html").read_text()
     assert "data:image/png;base64," in html and "http" not in html.split("<body>")[1]

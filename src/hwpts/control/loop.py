@@ -105,7 +105,7 @@ def run_loop(scenario: Scenario, controller, seed: int = 0, noise_std_rpm: float
         cols["pump_speed_rpm"][k] = pump
         cols["valve_command_v"][k] = u
         cols["valve_compensated_v"][k] = controller.effective
-        cols["region"][k] = controller.region
+        cols["region"][k] = controller.region + 1  # 1-based as in the model file and summary; 0: no region (pi)
         plant.step(u, wcmd[k])
         cols["valve_effective_v"][k] = plant.effective_voltage_v
         if progress is not None and k % every == 0:

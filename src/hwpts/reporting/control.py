@@ -81,10 +81,10 @@ def loop_figure(runs: dict, title: str, window=None) -> bytes:
             ax.legend(fontsize=7, loc="lower left")
         ax = axes[3, j]
         region = cols["region"][sel]
-        if np.all(region < 0):
+        if np.all(region <= 0):
             ax.text(0.5, 0.5, "no modes", ha="center", va="center", transform=ax.transAxes, fontsize=8, color="#666")
         else:
-            ax.step(t[sel], region + 1, where="post", color="tab:red", lw=0.8)
+            ax.step(t[sel], region, where="post", color="tab:red", lw=0.8)
         ax.set_ylim(-0.2, 4.2)
         if j == 0:
             ax.set_ylabel("region [-]")
