@@ -21,6 +21,8 @@ def test_run_writes_the_contract(tmp_path, paper_model_file, paper_model_doc, ca
     s = json.loads((out / "summary.json").read_text())
     assert s["schema"] == "hwpts.control/1"
     assert s["scenario"] == "setpoint-step" and s["seed"] == 1 and s["setpoint_rpm"] == 1000.0
+    assert s["duration_s"] == 8.0  # the --duration given, kept beside the command line that gave it
+    assert s["run"]["command"].startswith("hwpts control run --scenario setpoint-step") and s["run"]["seed"] == 1
     assert s["best"] in ("pi", "scheduled", "scheduled-no-inverse")
     assert set(s["controllers"]) == {"pi", "scheduled", "scheduled-no-inverse"}
     assert set(METRIC_NAMES) == CONTRACT_KEYS
@@ -41,6 +43,7 @@ def test_run_writes_the_contract(tmp_path, paper_model_file, paper_model_doc, ca
     assert (out / "figures" / "setpoint-step.png").exists()
     html = (out / "report.html").read_text()
     assert "data:image/png;base64," in html and "http" not in html.split("<body>")[1]
+    assert "record 8 s" in html and "<code>hwpts control run --scenario setpoint-step" in html
     assert "RMS error" in capsys.readouterr().out
 
 

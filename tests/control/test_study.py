@@ -26,6 +26,7 @@ def _study(tmp_path, model_file, *extra):
 
 def _check(summary, table):
     assert summary["schema"] == "hwpts.control-study/1"
+    assert summary["duration_s"] == 8.0 and summary["run"]["command"].startswith("hwpts control study --plants 2")
     assert set(summary["controllers"]) == {"pi", "scheduled"}
     assert len(table["controller"]) == 2 * 1 * 2
     assert sorted(set(table["plant"])) == [0, 1]

@@ -209,6 +209,7 @@ def study_command(args) -> int:
 
     from hwpts.control.controllers import parse_names
     from hwpts.control.study import PLANT_TOLERANCES, TARGETS, run_study
+    from hwpts.reporting.summary import run_info
     from hwpts.errors import DataError, ParameterError
     from hwpts.io.atomic import write_text_atomic
     from hwpts.io.datasets import write_table
@@ -248,7 +249,8 @@ def study_command(args) -> int:
                "seed": args.seed, "controllers": result.summary, "targets": TARGETS,
                "plant_tolerances": PLANT_TOLERANCES, "model": {"source": source, "sample_time_s": sample_time,
                                                                "hysteresis_half_width_v": half_width},
-               "scheduler": args.scheduler or "local cluster", "timings_s": {}}
+               "duration_s": _duration_of(args.scenario, args.duration), "scheduler": args.scheduler or "local cluster",
+               "run": run_info(args.seed, getattr(args, "command_line", None)), "timings_s": {}}
     if added_pi:
         print("control study: pi added to --controllers (the baseline of the 30 % RMS target)", file=sys.stderr)
 
@@ -278,6 +280,14 @@ def study_command(args) -> int:
     return 0
 
 
+def _duration_of(scenario: str, duration) -> float:
+    """The record length [s] a scenario runs for with ``--duration`` (None: the scenario's own)."""
+    from hwpts.control.scenarios import build_scenario
+
+    time = build_scenario(scenario, 0, duration=duration).time
+    return round(float(time[-1] - time[0]), 6)
+
+
 def run_command(args) -> int:
     """``hwpts control run``: the controllers closed loop on one scenario; writes summary.json, data, figures and report.html."""
     import json
@@ -294,6 +304,7 @@ def run_command(args) -> int:
     from hwpts.io.folders import check_replaceable, staged_folder
     from hwpts.io.models import save_model
     from hwpts.reporting.control import loop_figure, metric_table, render_control_report, zoom_window
+    from hwpts.reporting.summary import run_info
 
     if args.scenario not in SCENARIOS:
         raise ParameterError(f"--scenario: unknown scenario {args.scenario!r}; expected one of {', '.join(SCENARIOS)}")
@@ -328,6 +339,8 @@ def run_command(args) -> int:
             write_bytes_atomic(stage / "figures" / name, data)
         if not args.model:
             save_model(model, stage / "model.json")
+        summary["duration_s"] = round(float(scenario.time[-1] - scenario.time[0]), 6)
+        summary["run"] = run_info(args.seed, getattr(args, "command_line", None))
         summary["timings_s"] = {"total": round(time.perf_counter() - start, 2)}
         write_text_atomic(stage / "report.html", render_control_report(summary, figures))
         write_text_atomic(stage / "summary.json", json.dumps(summary, indent=2) + "\n")

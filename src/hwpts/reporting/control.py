@@ -8,6 +8,7 @@ import html
 import numpy as np
 
 from hwpts.reporting.figures import _png, _pyplot
+from hwpts.reporting.html import _run_line
 
 METRIC_LABELS = (
     ("rms_error_percent", "RMS error [%]", "{:.3f}"),
@@ -123,6 +124,7 @@ def render_control_report(summary: dict, figures: dict[str, bytes]) -> str:
     figs = "".join(f"<figure><img alt='{esc(k)}' src='data:image/png;base64,{base64.b64encode(v).decode()}'>"
                    f"<figcaption>{esc(k)}</figcaption></figure>" for k, v in figures.items())
     notes = "".join(f"<li>{esc(s)}</li>" for s in summary.get("notes", []))
+    record = f", record {summary['duration_s']:g} s" if summary.get("duration_s") is not None else ""
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>hwpts control: {esc(summary['scenario'])}</title>
 <style>
@@ -134,8 +136,9 @@ figure {{ margin: 1.2em 0; }} img {{ max-width: 100%; border: 1px solid #ddd; }}
 <h1>Speed control of the HWPTS: scenario {esc(summary['scenario'])}</h1>
 <p>{esc(summary['description'])}. Set-point {summary['setpoint_rpm']:g} r/min, seed {summary['seed']}; model bank
 {esc(summary['model']['source'])} ({summary['model']['n_regions']} regions, sample time {summary['model']['sample_time_s']:g} s,
-valve play half-width {summary['model']['hysteresis_half_width_v']:g} V). Loop period {summary['sample_time_s'] * 1000:g} ms.
+valve play half-width {summary['model']['hysteresis_half_width_v']:g} V). Loop period {summary['sample_time_s'] * 1000:g} ms{record}.
 Best model-based controller (lowest RMS error): <b>{esc(summary['best'])}</b>.</p>
+{_run_line(summary)}
 <h2>Metrics</h2>
 <p>Errors of the true motor A speed in % of the set-point, over the time the set-point is within reach (pump fast enough for
 at least {summary['reachable_hold_s']:g} s). A dash: the metric does not apply to this scenario.</p>
