@@ -83,3 +83,26 @@ def test_model_whose_inputs_are_not_valve_and_pump(tmp_path, capsys, paper_model
     err = capsys.readouterr().err
     assert code == 2 and err.count("\n") == 1
     assert "inputs must be the valve voltage and the pump speed" in err and "force" in err
+
+
+@pytest.mark.parametrize("inputs, output, expected", [
+    # "pump" in the name, but a pressure: it was read as the pump speed in r/min
+    (["valve_voltage_v", "pump_pressure_pa"], "motor_a_speed_rpm", "pump input 'pump_pressure_pa' is in Pa"),
+    (["valve_voltage_pct", "pump_speed_rpm"], "motor_a_speed_rpm", "valve input 'valve_voltage_pct' is in %"),
+    (["valve_voltage_v", "pump_speed_rpm"], "motor_a_speed_hz", "output 'motor_a_speed_hz' is in Hz"),
+])
+def test_model_whose_signals_are_in_other_units(tmp_path, capsys, inputs, output, expected):
+    import numpy as np
+
+    from hwpts.identification import PWARX
+    from hwpts.io.models import save_model
+
+    rng = np.random.default_rng(0)
+    u = rng.uniform(size=(200, 2))
+    y = u @ [1.0, 2.0] + 0.01 * rng.standard_normal(200)
+    path = tmp_path / "other.json"
+    save_model(PWARX(1, 1, 1, segmentation="average").fit(u, y, input_names=inputs, output_name=output), path)
+    code = main(["control", "run", "--scenario", "pump-step", "--model", str(path), "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1
+    assert expected in err

@@ -29,6 +29,25 @@ PUMP_WORDS = ("pump",)
 OTHER_OUTPUT_WORDS = ("motor_b", "pump", "pressure", "valve", "spool")  # an output that is not motor A's speed
 
 
+SIGNAL_UNITS = ("V", "r/min", "r/min")
+"""The units the controllers read the model's valve input, pump input and output in."""
+
+
+def _check_units(document: dict, inputs, output) -> None:
+    """Refuse a model whose valve input, pump input or output is in another unit than the controllers
+    command and measure (V, r/min, r/min): the units the file records, else those of the names'
+    suffixes (``pump_pressure_pa`` matched "pump" and was read as a speed in r/min)."""
+    from hwpts.units import unit_from_name
+
+    recorded = (document.get("signals") or {}).get("units") or {}
+    roles = ("valve input", "pump input", "output")
+    for role, name, expected in zip(roles, [*inputs, output], SIGNAL_UNITS):
+        unit = recorded.get(name) or unit_from_name(name)
+        if unit is not None and unit != expected:
+            raise DataError(f"the model's {role} {name!r} is in {unit}; the controllers read the valve voltage in V, "
+                            f"the pump speed and motor A's speed in r/min")
+
+
 @dataclass(frozen=True)
 class RegionDesign:
     """What a controller designer needs of one region's model (valve channel: u1 -> y)."""
@@ -76,6 +95,7 @@ class ModelBank:
             # a model of motor B's speed (or a pressure) designed controllers that steered motor A
             raise DataError(f"the model's output must be the main motor's (motor A's) speed, which the controllers "
                             f"hold; the model's output is {self.output_name!r}")
+        _check_units(document, names, self.output_name)
         self.sample_time = float(sample_time)
         self.na = int(st["na"])
         nb, nk = st["nb"], st["nk"]
