@@ -102,6 +102,38 @@ def test_a_model_refuses_data_at_another_sample_time(files, tmp_path, capsys):
     assert json.loads(capsys.readouterr().out)["n_samples"] == 300
 
 
+@pytest.mark.parametrize("form", ["parquet unnamed index", "parquet timestamp", "csv iso", "csv iso zone"])
+def test_time_stamps_are_the_time_axis_by_their_type_or_text(tmp_path, capsys, form):
+    """A Parquet column typed as time stamps (pandas' DatetimeIndex written as it is, or named
+    ``timestamp``) and a CSV time column of ISO 8601 date-times are the time axis: 5 ms data were
+    validated against a 10 ms model at exit 0, and the model fitted on them had no sample time."""
+    pa = pytest.importorskip("pyarrow")
+    import pyarrow.parquet as pq
+
+    t, u, y = _second_order(n=1000)
+    model = tmp_path / "m.json"
+    write_csv(tmp_path / "slow.csv", {"time_s": t, "u1": u[:, 0], "u2": u[:, 1], "y": y})
+    fit = ["--input", "u1", "--input", "u2", "--output", "y", "--na", "2", "--nb", "1", "--segmentation", "average"]
+    assert main(["identify", str(tmp_path / "slow.csv"), *fit, "--out", str(model)]) == 0
+    capsys.readouterr()
+    stamps = np.datetime64("2024-01-01T00:00:00", "ns") + (t * 5e8).astype("timedelta64[ns]")  # every 5 ms
+    if form.startswith("parquet"):
+        fast = tmp_path / "fast.parquet"
+        name = "__index_level_0__" if form.endswith("index") else "timestamp"
+        pq.write_table(pa.table({"u1": u[:, 0], "u2": u[:, 1], "y": y, name: pa.array(stamps)}), fast)
+    else:
+        zone = "Z" if form.endswith("zone") else ""
+        text = [str(s).replace("T", " " if not zone else "T") + zone for s in stamps]
+        fast = tmp_path / "fast.csv"
+        fast.write_text("time,u1,u2,y\n" + "".join(f"{s},{float(a)!r},{float(b)!r},{float(c)!r}\n" for s, a, b, c in
+                                                    zip(text, u[:, 0], u[:, 1], y)))
+    assert main(["validate", str(model), str(fast)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "sample time 0.005 s (200 Hz) differs from the model's 0.01 s (100 Hz)" in err[0]
+    assert main(["identify", str(fast), *fit, "--out", str(tmp_path / "fast.json")]) == 0
+    assert json.loads(capsys.readouterr().out)["sample_time_s"] == pytest.approx(0.005)
+
+
 def test_a_time_column_is_found_by_its_conventional_name(tmp_path, capsys):
     """A model fitted on data whose time column is named t_s (as the pick-and-place files) knows its
     sample time without --time, and data at another rate in a column named t are refused (before,

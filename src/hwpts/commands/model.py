@@ -104,7 +104,7 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None, uni
     applied silently to data sampled at another rate; ``time_name="none"`` uses the row index.
     """
     from hwpts.dataset import IODataset
-    from hwpts.io.datasets import numeric_share, read_table, temporal_columns
+    from hwpts.io.datasets import column_names, csv_datetime_seconds, numeric_share, read_table, temporal_columns
     from hwpts.io.paths import check_input_file
 
     if not str(path).strip():
@@ -119,19 +119,27 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None, uni
     elif time_name is not None:
         candidates = [time_name]
     else:
-        from hwpts.io.datasets import column_names
-
         # (none from a .mat file, not read twice for its names: its time is a vector of the
         # conventional names or its Ts)
         others = [c for c in column_names(path) if TIME_PATTERN.fullmatch(c) and c not in TIME_COLUMNS]
         candidates = [c for c in (*TIME_COLUMNS, *others) if c not in signals]
+        # a Parquet file's one column typed as time, whatever its name (pandas writes a DataFrame's
+        # time index as __index_level_0__ or under the index's name: 5 ms data were compared with a
+        # 10 ms model without a word)
+        typed = sorted(temporal_columns(path) - set(signals))
+        if len(typed) == 1 and typed[0] not in candidates:
+            candidates.append(typed[0])
+    # a CSV time column of ISO 8601 date-times (a logger's wall clock), in seconds from its first stamp
+    header = set(column_names(path)) if candidates else set()
+    stamps = {c: v for c in candidates if c in header and (v := csv_datetime_seconds(path, c)) is not None}
+    numeric = [c for c in candidates if c not in stamps]
     try:
-        columns = read_table(path, [*signals, *candidates])
+        columns = read_table(path, [*signals, *numeric])
     except DataError:
-        if time_name is not None or not candidates:
+        if time_name is not None or not numeric:
             raise
         readable = []
-        for name in candidates:  # a conventionally named column that holds text is no time axis ...
+        for name in numeric:  # a conventionally named column that holds text is no time axis ...
             try:
                 read_table(path, [*signals, name])
                 readable.append(name)
@@ -139,6 +147,7 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None, uni
                 if numeric_share(path, name) > 0.5:  # ... but one of numbers with mistyped cells is broken
                     raise
         columns = read_table(path, [*signals, *readable])  # (a bad signal column raises its own error here)
+    columns.update(stamps)
     if time_name not in (None, NO_TIME) and time_name not in columns:
         raise DataError(f"{str(path)!r}: no time column {time_name!r}; {_available(path, columns)}")
     missing = [c for c in signals if c not in columns]
@@ -177,9 +186,10 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None, uni
     tname = next((c for c in candidates if c in cols and c not in soft), None)
     period = _mat_sample_time(path, columns) if time_name is None else None
     detected = time_name is None and tname is not None
-    hint = f" ({tname!r} is taken as the time column by its name; --time none uses the sample index)" if detected else ""
+    how = "its name" if tname in TIME_COLUMNS or TIME_PATTERN.fullmatch(str(tname)) else "its type"
+    hint = f" ({tname!r} is taken as the time column by {how}; --time none uses the sample index)" if detected else ""
     timed = tname is not None
-    if timed and time_seconds(tname) != 1.0 and tname not in temporal_columns(path):
+    if timed and time_seconds(tname) != 1.0 and tname not in temporal_columns(path) and tname not in stamps:
         # a column of numbers named in ms (time_ms), minutes, ...; a typed Parquet time is in seconds already
         cols[tname] = np.asarray(cols[tname], dtype=float) * time_seconds(tname)
     if tname is None:

@@ -204,6 +204,37 @@ def numeric_share(path: str | os.PathLike, column: str) -> float:
     return sum(is_number(c) for c in cells) / len(cells) if cells else 0.0
 
 
+def csv_datetime_seconds(path: str | os.PathLike, column: str) -> np.ndarray | None:
+    """A CSV column of ISO 8601 date-times (``2024-01-01 00:00:00.005``, ``...T...Z``, with an offset,
+    or plain dates) in seconds from its first stamp; None when the file is no CSV, has no such column,
+    or a cell is empty or not such a date-time (a logger's wall-clock stamps as the time axis: read as
+    text they were dropped, and the data compared at the model's rate without a word)."""
+    p = Path(path)
+    try:
+        if p.suffix.lower() != ".csv" or not p.is_file():  # (a FIFO would block the read)
+            return None
+        text = p.read_text(encoding="utf-8-sig", errors="replace")
+    except OSError:
+        return None
+    rows = [r for r in csv.reader(io.StringIO(text), delimiter=_sniff(p)) if any(c.strip() for c in r)]
+    header = [h.strip() for h in rows[0]] if rows else []
+    if column not in header or len(rows) < 2:
+        return None
+    j = header.index(column)
+    cells = [r[j].strip() if j < len(r) else "" for r in rows[1:]]
+    if not all(cells) or is_number(cells[0]) or not re.match(r"\d{4}-\d{2}-\d{2}", cells[0]):
+        return None
+    import pyarrow as pa
+
+    for kind in (pa.timestamp("ns"), pa.timestamp("ns", tz="UTC")):  # naive, then with a zone or offset
+        try:
+            ns = pa.array(cells).cast(kind).cast(pa.int64()).to_numpy(zero_copy_only=False)
+        except (pa.ArrowInvalid, pa.ArrowNotImplementedError):
+            continue
+        return (ns - ns[0]).astype(float) / 1e9
+    return None
+
+
 def is_number(text: str) -> bool:
     """Whether ``text`` reads as a number (a header cell that is a number: no header row)."""
     try:
