@@ -67,6 +67,23 @@ def test_residuals_tell_a_correct_model_from_a_wrong_one(files, capsys):
     _png_ok(files / "r.png")
 
 
+def test_residuals_of_a_constant_input_are_not_tested(files, tmp_path, capsys):
+    """An input held constant (the pump speed through a valve test) has no correlation with the
+    residuals to test: said, and null in the JSON (it was "uncorrelated", every lag inside the band)."""
+    t, u, y = _second_order(seed=1, n=600)
+    held = tmp_path / "held.csv"
+    write_csv(held, {"time_s": t, "valve_v": u[:, 0], "u2": np.full_like(t, 0.3), "y_mm": y})
+    capsys.readouterr()
+    assert main(["residuals", str(files / "good.json"), str(held), "--plot", str(tmp_path / "r.png")]) == 0
+    out = capsys.readouterr().out
+    assert "input u2: constant on these data: not tested" in out and "input valve_v:" in out
+    assert main(["residuals", str(files / "good.json"), str(held), "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert result["outside_share"]["cross_correlation"]["u2"] is None
+    assert result["independent_of_inputs"] is None and result["untested_inputs"] == ["u2"]
+    assert result["white"] is not None
+
+
 def test_predict_horizon_one_is_one_step_and_n_is_the_free_run(files, tmp_path):
     data, model = str(files / "data.csv"), str(files / "good.json")
 

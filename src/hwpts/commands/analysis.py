@@ -41,9 +41,16 @@ def cmd_residuals(args) -> int:
               "reproduces the data exactly, and the whiteness and input-correlation tests, which assume a "
               "noise, do not apply")
     else:
-        print(f"whiteness: {100 * share['autocorrelation']:.1f} % of lags 1..{args.lags} outside the {conf} band "
-              f"(+-{result['band']:.4g}) -> {'white' if result['white'] else 'NOT white'}")
+        if share["autocorrelation"] is None:
+            print("whiteness: the residuals are constant on these data: not tested (no spread to correlate)")
+        else:
+            print(f"whiteness: {100 * share['autocorrelation']:.1f} % of lags 1..{args.lags} outside the {conf} band "
+                  f"(+-{result['band']:.4g}) -> {'white' if result['white'] else 'NOT white'}")
         for name, value in share["cross_correlation"].items():
+            if value is None:
+                print(f"input {name}: constant on these data: not tested (its correlation with the residuals is "
+                      f"undefined)")
+                continue
             print(f"input {name}: {100 * value:.1f} % of lags 0..{args.lags} outside the band -> "
                   f"{'uncorrelated' if value <= 0.05 else 'CORRELATED'}")
     if args.plot is not None:

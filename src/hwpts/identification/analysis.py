@@ -134,13 +134,22 @@ class ResidualAnalysis:
         return int(self.residuals.shape[0])
 
     def outside_share(self) -> dict:
-        """Share of tested lags outside the band: autocorrelation (lags 1..L), each input (0..L), all."""
-        auto = np.abs(self.autocorrelation[1:]) > self.band
-        cross = {k: np.abs(v) > self.band for k, v in self.cross_correlation.items()}
-        every = np.concatenate([auto, *cross.values()])
-        return {"autocorrelation": float(np.mean(auto)),
-                "cross_correlation": {k: float(np.mean(v)) for k, v in cross.items()},
-                "all": float(np.mean(every))}
+        """Share of tested lags outside the band: autocorrelation (lags 1..L), each input (0..L), all.
+
+        A correlation that is undefined (a constant input, such as a pump speed held through a valve
+        test, or constant residuals: no spread to normalise by) is not tested: its share is None
+        (it was counted as inside the band, every lag: "uncorrelated")."""
+        def outside(values):
+            values = np.asarray(values, dtype=float)
+            return None if not np.all(np.isfinite(values)) else np.abs(values) > self.band
+
+        auto = outside(self.autocorrelation[1:])
+        cross = {k: outside(v) for k, v in self.cross_correlation.items()}
+        tested = [v for v in (auto, *cross.values()) if v is not None]
+        mean = lambda v: None if v is None else float(np.mean(v))  # noqa: E731
+        return {"autocorrelation": mean(auto),
+                "cross_correlation": {k: mean(v) for k, v in cross.items()},
+                "all": float(np.mean(np.concatenate(tested))) if tested else None}
 
     def to_dict(self) -> dict:
         """JSON-ready: the correlations, the band and the shares of lags outside it."""
@@ -152,8 +161,10 @@ class ResidualAnalysis:
             "autocorrelation": [float(v) for v in self.autocorrelation],
             "cross_correlation": {k: [float(x) for x in v] for k, v in self.cross_correlation.items()},
             "outside_share": share,
-            "white": share["autocorrelation"] <= 0.05,
-            "independent_of_inputs": all(v <= 0.05 for v in share["cross_correlation"].values()),
+            "white": None if share["autocorrelation"] is None else share["autocorrelation"] <= 0.05,
+            "independent_of_inputs": None if None in share["cross_correlation"].values()
+            else all(v <= 0.05 for v in share["cross_correlation"].values()),
+            "untested_inputs": [k for k, v in share["cross_correlation"].items() if v is None],
             "exact": self.exact,
         }
 

@@ -78,7 +78,8 @@ def residual_figure(analysis, *, output_name: str = "y", unit: str | None = None
         ax.axhspan(-band, band, color="tab:orange", alpha=0.2, label=f"{conf} (+-{band:.3g})")
         ax.axhline(0.0, color="gray", lw=0.6)
         ax.set_ylabel("correlation [-]")
-        ax.set_title(f"{what}: {100 * outside:.1f} % of lags outside the band", fontsize=10)
+        verdict = "not tested (constant on these data)" if outside is None else f"{100 * outside:.1f} % of lags outside the band"
+        ax.set_title(f"{what}: {verdict}", fontsize=10)
         ax.legend(loc="upper right", fontsize=8)
         ax.grid(alpha=0.3)
 
