@@ -53,6 +53,24 @@ def test_validate_plot_writes_a_figure(files, capsys):
     _png_ok(out)
 
 
+def test_validate_plot_labels_the_axis_by_the_datas_time(files, tmp_path, monkeypatch, capsys):
+    """A model without a sample time validated on data with a time column: the axis is in seconds
+    (it was labelled "sample" under the data's seconds); on data without one, it is the sample."""
+    import hwpts.reporting.analysis as figures
+
+    seen = []
+    real = figures.validation_figure
+    monkeypatch.setattr(figures, "validation_figure", lambda *a, **k: seen.append(k["time_unit"]) or real(*a, **k))
+    t, u, y = _second_order(n=400)
+    write_csv(tmp_path / "notime.csv", {"valve_v": u[:, 0], "u2": u[:, 1], "y_mm": y})
+    fit = ["--input", "valve_v", "--input", "u2", "--output", "y_mm", "--na", "2", "--nb", "1", "--segmentation", "average"]
+    assert main(["identify", str(tmp_path / "notime.csv"), *fit, "--out", str(tmp_path / "m.json")]) == 0
+    assert main(["validate", str(tmp_path / "m.json"), str(files / "data.csv"), "--plot", str(tmp_path / "a.png")]) == 0
+    assert main(["validate", str(tmp_path / "m.json"), str(tmp_path / "notime.csv"), "--plot", str(tmp_path / "b.png")]) == 0
+    assert seen == ["s", None]
+    capsys.readouterr()
+
+
 def test_residuals_tell_a_correct_model_from_a_wrong_one(files, capsys):
     capsys.readouterr()
     assert main(["residuals", str(files / "good.json"), str(files / "data.csv"), "--json",

@@ -905,6 +905,9 @@ def _model_and_data(args):
                              uniform=False if args.resample else None if resamplable else True)
     data = _check_sample_time(model, data, dt, args.data, args.resample)
     st.check_length(data.n_samples, what=_selection(args, repr(str(args.data))))
+    # the data's time is in seconds when they have a time column or the model a sample time (else it
+    # is the sample index): a figure's axis says which (it said "sample" under the data's seconds)
+    args.time_in_seconds = dt is not None or getattr(model, "sample_time_", None) is not None
     return model, data
 
 
@@ -945,7 +948,7 @@ def _write_validation_plot(model, data, result, args):
 
     sim = model.simulate(data.inputs, data.output)
     units = getattr(model, "units_", {}) or {}
-    timed = getattr(model, "sample_time_", None) is not None and args.time != "__index__"
+    timed = getattr(args, "time_in_seconds", False)
     png = validation_figure(
         data.time, data.output, sim.output, sim.regions, n_initial=model.structure_.max_lag,
         output_name=model.structure_.output_name, unit=units.get(model.structure_.output_name),
