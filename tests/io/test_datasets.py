@@ -119,11 +119,14 @@ def test_a_blank_line_between_data_rows_is_refused_with_its_line(tmp_path, gap, 
     '"V1","V2",\n0.5,1.5,\n-2,3,\n',          # the official Silverbox file: quoted names, trailing comma
     "V1;V2\r\n0.5;1.5\r\n-2;3\r\n",             # semicolons and CRLF
     "\ufeffV1\tV2\n0.5\t1.5\n-2\t3\n",          # a byte-order mark and tabs
+    ',V1,V2\n0,0.5,1.5\n1,-2,3\n',              # pandas' to_csv: its unnamed row index first (it was refused)
+    '"V1";"V2";"x, y"\n0.5;1.5;7\n-2;3;8\n',     # commas inside quoted names (it was read as comma-separated)
+    '"V1"\t"V2"\t"a, b, c"\n0.5\t1.5\t7\n-2\t3\t8\n',
 ])
 def test_csv_forms_read_as_published(tmp_path, text):
     path = tmp_path / "d.csv"
     path.write_text(text, encoding="utf-8")
-    cols = read_table(path)
+    cols = read_table(path, ["V1", "V2"])
     assert list(cols) == ["V1", "V2"]
     np.testing.assert_array_equal(cols["V1"], [0.5, -2.0])
     np.testing.assert_array_equal(cols["V2"], [1.5, 3.0])

@@ -65,7 +65,8 @@ def _sniff(p: Path, head: bytes | None = None) -> str:
             raise DataError(f"{str(p)!r}: cannot read ({error.strerror or error})") from None
     text = head[:65536].decode("utf-8-sig", errors="replace")
     first = next((line for line in text.splitlines() if line.strip()), "")
-    counts = {d: first.count(d) for d in DELIMITERS}
+    outside = re.sub(r'"[^"]*"', "", first)  # not inside quoted names ("u, V";"y, rpm" is a semicolon file)
+    counts = {d: outside.count(d) for d in DELIMITERS}
     best = max(counts, key=counts.get)
     return best if counts[best] > 0 else ","
 
@@ -97,11 +98,11 @@ def read_csv(path: str | os.PathLike, columns=None) -> dict[str, np.ndarray]:
         names = [str(n).strip() for n in table.column_names]
     except UnicodeDecodeError:  # a header that is not UTF-8
         return _read_csv_python(p, delimiter, columns)  # raises the precise error
-    # an unnamed column with no value (a trailing delimiter on every row) is not a column
-    keep = [i for i, n in enumerate(names) if n or table.column(i).null_count < table.num_rows]
-    if any(not names[i] for i in keep) or len({names[i] for i in keep}) != len(keep) \
-            or all(is_number(names[i]) for i in keep):
-        return _read_csv_python(p, delimiter, columns)  # empty, duplicate or numeric names: said precisely
+    # an unnamed column (a trailing delimiter on every row, or the row index pandas' to_csv writes
+    # first) cannot be asked for: it is not read
+    keep = [i for i, n in enumerate(names) if n]
+    if not keep or len({names[i] for i in keep}) != len(keep) or all(is_number(names[i]) for i in keep):
+        return _read_csv_python(p, delimiter, columns)  # no, duplicate or numeric names: said precisely
     if table.num_rows == 0:
         raise DataError(f"{str(p)!r}: no data rows after the header")
     wanted = [i for i in keep if columns is None or names[i] in set(columns)]
@@ -276,18 +277,19 @@ def _read_csv_python(p: Path, delimiter: str = ",", columns=None) -> dict[str, n
     if header and header[0].startswith("#") and len(numbered) > 1 and len(numbered[1][1]) != len(numbered[0][1]):
         raise DataError(f"{str(p)!r} line {numbered[0][0]}: expected the header row of column names, got a comment "
                         f"({header[0][:40]!r}); remove the comment lines above the header")
-    if header and all(is_number(h) for h in header):
+    named = [h for h in header if h]  # an unnamed column (pandas' row index) cannot be asked for: not read
+    if named and all(is_number(h) for h in named):
         raise DataError(f"{str(p)!r}: expected a header row of column names first (a header row such as u,y), got numbers "
                         f"({delimiter.join(header[:4])}{', ...' if len(header) > 4 else ''})")
-    if len(set(header)) != len(header):
-        dup = sorted({h for h in header if header.count(h) > 1})
+    if len(set(named)) != len(named):
+        dup = sorted({h for h in named if named.count(h) > 1})
         raise DataError(f"{str(p)!r}: duplicate column name(s) {dup}")
-    if any(not h for h in header):
-        raise DataError(f"{str(p)!r}: empty column name in the header row")
+    if not named:
+        raise DataError(f"{str(p)!r}: no column names in the header row")
     body = numbered[1:]
     if not body:
         raise DataError(f"{str(p)!r}: no data rows after the header")
-    wanted = [j for j, h in enumerate(header) if columns is None or h in set(columns)]
+    wanted = [j for j, h in enumerate(header) if h and (columns is None or h in set(columns))]
     missing = _missing_cells()
     values = np.empty((len(body), len(header)))
     for k, (i, row) in enumerate(body):
