@@ -56,6 +56,11 @@ def test_mat_vectors_and_matrices(tmp_path):
     ("a,a\n1,2\n", "duplicate column"),
     ("a,b\n1,2\n3\n", "line 3: 1 fields, expected 2"),
     ("a,b\n1,x\n", "column 'b': expected a number, got 'x'"),
+    # comment lines or Excel's delimiter line above the header: said as such (two comment lines, or a
+    # MATLAB %, were "line 3: 3 fields, expected 1 (as in the header)")
+    ("# logger v1\n# 2024-01-01\na,b\n1,2\n", "line 1: expected the header row .* got a comment .* remove the 2 lines"),
+    ("% logger v1\na,b\n1,2\n", "line 1: expected the header row .* got a comment \\('% logger v1'\\)"),
+    ("sep=;\na;b\n1;2\n", "line 1: expected the header row .* got Excel's delimiter line"),
 ])
 def test_bad_csv(tmp_path, text, match):
     path = tmp_path / "bad.csv"

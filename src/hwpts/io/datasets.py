@@ -274,9 +274,17 @@ def _read_csv_python(p: Path, delimiter: str = ",", columns=None) -> dict[str, n
     header = [h.strip() for h in numbered[0][1]]
     while header and not header[-1]:  # trailing empty columns (a comma at the end of every row)
         header.pop()
-    if header and header[0].startswith("#") and len(numbered) > 1 and len(numbered[1][1]) != len(numbered[0][1]):
-        raise DataError(f"{str(p)!r} line {numbered[0][0]}: expected the header row of column names, got a comment "
-                        f"({header[0][:40]!r}); remove the comment lines above the header")
+    def remark(row):  # a comment line (# or MATLAB's %) or Excel's "sep=;" line above the header
+        first = row[0].strip() if row else ""
+        return first.startswith(("#", "%")) or bool(re.fullmatch(r"sep=.?", delimiter.join(row).strip()))
+
+    n = next((k for k, (_, row) in enumerate(numbered) if not remark(row)), len(numbered))
+    excel = bool(header) and header[0].lower().startswith("sep=")
+    if header and n and n < len(numbered) and (excel or len(numbered[n][1]) != len(numbered[0][1])):
+        what = "Excel's delimiter line" if excel else "a comment"
+        raise DataError(f"{str(p)!r} line {numbered[0][0]}: expected the header row of column names, got {what} "
+                        f"({delimiter.join(numbered[0][1])[:40]!r}); remove the {n} line{'s' if n > 1 else ''} "
+                        f"above the header")
     named = [h for h in header if h]  # an unnamed column (pandas' row index) cannot be asked for: not read
     if named and all(is_number(h) for h in named):
         raise DataError(f"{str(p)!r}: expected a header row of column names first (a header row such as u,y), got numbers "
