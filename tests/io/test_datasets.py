@@ -171,6 +171,17 @@ def test_a_mat_matrix_column_and_a_variable_of_its_name_are_refused(tmp_path):
         read_table(tmp_path / "clash.mat")
 
 
+def test_a_mat_file_without_vectors_names_what_it_skipped(tmp_path):
+    """A struct of signals or a square matrix alone: the variables skipped and why (it was "no
+    numeric vector variables" with no hint)."""
+    savemat(tmp_path / "s.mat", {"exp": {"u": np.ones(10), "y": np.arange(10.0)}})
+    with pytest.raises(DataError, match=r"no numeric vector variables .*'exp' holds no numbers .*a struct"):
+        read_table(tmp_path / "s.mat")
+    savemat(tmp_path / "q.mat", {"data": np.eye(5)})
+    with pytest.raises(DataError, match=r"'data' is a square 5x5 matrix"):
+        read_table(tmp_path / "q.mat")
+
+
 def test_a_text_variable_does_not_clash_with_a_matrix_column(tmp_path):
     savemat(tmp_path / "ok.mat", {"u": np.ones((10, 2)), "u_1": "a note", "y": np.arange(10.0)})
     assert sorted(read_table(tmp_path / "ok.mat")) == ["u_1", "u_2", "y"]

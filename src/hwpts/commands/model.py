@@ -159,7 +159,9 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None, uni
             c = next(c for c in missing if c in unread)
             raise DataError(f"{str(path)!r}: the variable {c!r} {unread[c]}; save each signal as a numeric "
                             f"vector; {_available(path, columns)}")
-        raise DataError(f"{str(path)!r}: no column(s) {missing}; {_available(path, columns)}")
+        skipped = "; ".join(f"{name!r} {reason}" for name, reason in list(unread.items())[:4])
+        raise DataError(f"{str(path)!r}: no column(s) {missing}; {_available(path, columns)}"
+                        + (f" (not read: {skipped}; save each signal as a numeric vector)" if skipped else ""))
     sl = _rows(rows)
     total = len(columns[output_name])
     for end in (sl.start, sl.stop):

@@ -585,5 +585,8 @@ def _read_mat(p: Path) -> dict[str, np.ndarray]:
                                     f"would both be the column {column!r}; rename one of them")
                 out[column] = arr[:, j]
     if not out:
-        raise DataError(f"{str(p)!r}: no numeric vector variables in the .mat file")
+        skipped = mat_unread(p)  # (the file was just read: its last reading is kept)
+        why = "; ".join(f"{name!r} {reason}" for name, reason in list(skipped.items())[:4])
+        raise DataError(f"{str(p)!r}: no numeric vector variables in the .mat file"
+                        + (f" ({why}); save each signal as a numeric vector" if why else ""))
     return out
