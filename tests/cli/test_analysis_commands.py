@@ -185,6 +185,7 @@ def test_a_time_column_is_found_by_its_conventional_name(tmp_path, capsys):
     assert main(["validate", str(model), str(fast), "--json"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "sample time 0.001 s (1000 Hz) differs from the model's 0.01 s (100 Hz)" in err[0]
+    assert "('t' is taken as the time column by its name; --time none uses the sample index)" in err[0]
     assert main(["validate", str(model), str(fast), "--time", "none", "--json"]) == 0  # the user says so
     assert json.loads(capsys.readouterr().out)["n_samples"] == 1000
     # a column named like time that holds text is no time axis; one that is not increasing is named

@@ -94,8 +94,9 @@ def _available(path, found) -> str:
 
 
 def _load_dataset(path, input_names, output_name, time_name=None, rows=None, uniform=True):
-    """The named columns of a data file as an :class:`IODataset`; its ``sample_time_s`` attribute
-    is the sample period from the time column, or None when the file has none (time = row index).
+    """``(data, dt, hint)``: the named columns of a data file as an :class:`IODataset`, the sample
+    period from the time column (None when the file has none: time = row index), and the clause that
+    names a time column found by its name or type, for messages about the rate (else "").
     ``uniform``: a time column that is not uniform is refused (``None``: with ``--resample`` as the
     remedy), or ``False``: taken, with a sample period of ``nan`` (to be resampled).
 
@@ -220,7 +221,7 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None, uni
         elif abs(dt - value) > SAMPLE_TIME_TOLERANCE * value:
             raise DataError(f"{str(path)!r}: the time column {tname!r} is sampled every {dt:.6g} s but the variable "
                             f"{name!r} says {value:.6g} s; correct one of them, or pass --time none or --time COL")
-    return data, dt
+    return data, dt, hint
 
 
 def _mat_sample_time(path, columns) -> tuple[str, float] | None:
@@ -625,7 +626,7 @@ def cmd_identify(args) -> int:
         # a method that makes its own regions: --regions must agree or be left out
         raise ParameterError(f"--regions {args.regions}: --segmentation {args.segmentation} makes {count} "
                              f"region{'s' if count > 1 else ''}; leave --regions out or choose another method")
-    data, dt = _load_dataset(args.data, args.input, args.output, args.time, args.rows)
+    data, dt, _ = _load_dataset(args.data, args.input, args.output, args.time, args.rows)
     units = _units([*args.input, args.output], args.unit)
     delays = None
     if "input_delay" in searched:  # the delays 0 and 1 of the grid, or the dead time the data show
@@ -903,9 +904,12 @@ def _model_and_data(args):
     _check_signals(inputs, output)
     _check_mapped_units(model, inputs, output)
     resamplable = getattr(model, "sample_time_", None) is not None  # (--resample needs the model's rate)
-    data, dt = _load_dataset(args.data, inputs, output, args.time, args.rows,
-                             uniform=False if args.resample else None if resamplable else True)
-    data = _check_sample_time(model, data, dt, args.data, args.resample)
+    data, dt, hint = _load_dataset(args.data, inputs, output, args.time, args.rows,
+                                   uniform=False if args.resample else None if resamplable else True)
+    try:
+        data = _check_sample_time(model, data, dt, args.data, args.resample)
+    except DataError as error:  # which column gave the rate, where a name chose it (a temperature t)
+        raise DataError(f"{error}{hint}") from None
     st.check_length(data.n_samples, what=_selection(args, repr(str(args.data))))
     # the data's time is in seconds when they have a time column or the model a sample time (else it
     # is the sample index): a figure's axis says which (it said "sample" under the data's seconds)
