@@ -226,3 +226,13 @@ def test_an_epoch_time_axis_gives_the_sample_time_it_was_sampled_at():
                        (0.5 + np.arange(100) * 1e-4, 1e-4)):
         data = IODataset(time, np.zeros((time.size, 1)), np.arange(time.size, dtype=float), ["u"], "y")
         assert data.uniform_sample_time() == step
+
+
+def test_an_unreadable_mat_file_is_named_as_given(tmp_path, monkeypatch):
+    """A MATLAB v7.3 (HDF5) file: said, with the path the user gave (it was the resolved absolute path)."""
+    (tmp_path / "d").mkdir()
+    head = b"MATLAB 7.3 MAT-file, Platform: GLNXA64, HDF5 schema 1.00 .".ljust(116, b" ") + bytes(8) + b"\x00\x02IM"
+    (tmp_path / "d" / "v73.mat").write_bytes(head.ljust(512, b"\x00") + b"\x89HDF\r\n\x1a\n" + bytes(100))
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(DataError, match=r"^'d/v73.mat': a MATLAB v7.3 \(HDF5\) file"):
+        read_table("d/v73.mat")

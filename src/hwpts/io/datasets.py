@@ -474,7 +474,11 @@ def _loadmat_isolated(p: Path) -> dict:
         st = p.stat()
     except OSError:
         return _loadmat_child(p)  # (said by the reader)
-    return _loadmat_last(str(p.resolve()), st.st_size, st.st_mtime_ns, st.st_ino)
+    resolved = str(p.resolve())
+    try:
+        return _loadmat_last(resolved, st.st_size, st.st_mtime_ns, st.st_ino)
+    except DataError as error:  # named as the user gave it (the cache's key is the resolved path)
+        raise DataError(str(error).replace(repr(resolved), repr(str(p)), 1)) from None
 
 
 @functools.lru_cache(maxsize=1)
