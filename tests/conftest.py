@@ -11,29 +11,30 @@ settings.load_profile("default")
 
 
 def _drop_stale_numba_caches() -> None:
-    """Empty numba's on-disk caches of the package when any compiled module's source changed.
+    """Empty numba's on-disk caches of the package when any of its sources changed.
 
     numba checks only the file of a cached function: a constant or a compiled helper it calls from
-    another module (valve.py's MAKEUP_SMOOTHING_PA, used by dynamics.py's kernels) can change and
-    the cached kernel still runs the old one (a session saw an edit do nothing until the cache was
-    deleted). A clean clone, as CI's, has no cache; this is for a working copy."""
+    another module (valve.py's MAKEUP_SMOOTHING_PA, used by dynamics.py's kernels; the parameter
+    indices of parameters.py) can change and the cached kernel still runs the old one (a session
+    saw an edit do nothing until the cache was deleted). A clean clone, as CI's, has no cache; this
+    is for a working copy. Every source file is hashed: which ones a kernel depends on is not said."""
     import hashlib
+    import os
     from pathlib import Path
 
     root = Path(__file__).resolve().parent.parent / "src" / "hwpts"
-    if not root.is_dir():
+    if not root.is_dir() or os.environ.get("NUMBA_CACHE_DIR"):  # (a folder of the user's: not ours to empty)
         return
-    compiled = sorted(p for p in root.rglob("*.py") if "numba" in p.read_text(encoding="utf-8"))
-    digest = hashlib.sha256(b"".join(p.read_bytes() for p in compiled)).hexdigest()
+    digest = hashlib.sha256(b"".join(p.read_bytes() for p in sorted(root.rglob("*.py")))).hexdigest()
     stamp = root / "__pycache__" / "numba-sources.sha256"
     try:
         if stamp.exists() and stamp.read_text() == digest:
             return
         for cached in [*root.rglob("*.nbi"), *root.rglob("*.nbc")]:
             cached.unlink()
-        stamp.parent.mkdir(exist_ok=True)
+        stamp.parent.mkdir(parents=True, exist_ok=True)
         stamp.write_text(digest)
-    except OSError:  # a read-only checkout: numba caches elsewhere (hwpts._numba_cache_dir)
+    except (OSError, ValueError):  # a read-only checkout: numba caches elsewhere (hwpts._numba_cache_dir)
         pass
 
 

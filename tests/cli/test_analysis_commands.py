@@ -99,6 +99,10 @@ def test_residuals_of_a_constant_input_are_not_tested(files, tmp_path, capsys):
     result = json.loads(capsys.readouterr().out)
     assert result["outside_share"]["cross_correlation"]["u2"] is None
     assert result["independent_of_inputs"] is None and result["untested_inputs"] == ["u2"]
+    # a tested input that is correlated says so whatever the untested one (it was null)
+    assert main(["residuals", str(files / "wrong.json"), str(held), "--json"]) == 0
+    wrong = json.loads(capsys.readouterr().out)
+    assert wrong["outside_share"]["cross_correlation"]["valve_v"] > 0.05 and wrong["independent_of_inputs"] is False
     assert result["white"] is not None
 
 
@@ -167,6 +171,41 @@ def test_time_stamps_are_the_time_axis_by_their_type_or_text(tmp_path, capsys, f
     assert len(err) == 1 and "sample time 0.005 s (200 Hz) differs from the model's 0.01 s (100 Hz)" in err[0]
     assert main(["identify", str(fast), *fit, "--out", str(tmp_path / "fast.json")]) == 0
     assert json.loads(capsys.readouterr().out)["sample_time_s"] == pytest.approx(0.005)
+
+
+def test_time_stamps_not_taken_as_the_time_axis_are_said(tmp_path, capsys):
+    """ISO date-times in a column of another name, or that do not all read (an empty cell), leave the
+    rate unchecked: a warning says so (it was silent); --time on such a column is refused in a line;
+    a decimal comma (ISO 8601 allows it) reads."""
+    t, u, y = _second_order(n=400)
+    model = tmp_path / "m.json"
+    write_csv(tmp_path / "slow.csv", {"time_s": t, "u1": u[:, 0], "u2": u[:, 1], "y": y})
+    fit = ["--input", "u1", "--input", "u2", "--output", "y", "--na", "2", "--nb", "1", "--segmentation", "average"]
+    assert main(["identify", str(tmp_path / "slow.csv"), *fit, "--out", str(model)]) == 0
+    capsys.readouterr()
+    stamps = [str(np.datetime64("2024-01-01T00:00:00", "ms") + np.timedelta64(5 * k, "ms")).replace("T", " ")
+              for k in range(t.size)]
+
+    def write(name, column, cells, sep=","):
+        rows = "".join(sep.join([c, repr(float(a)), repr(float(b)), repr(float(d))]) + "\n"
+                       for c, a, b, d in zip(cells, u[:, 0], u[:, 1], y))
+        (tmp_path / name).write_text(sep.join([column, "u1", "u2", "y"]) + "\n" + rows)
+        return str(tmp_path / name)
+
+    named = write("named.csv", "timestamp", stamps)
+    assert main(["validate", str(model), named]) == 0
+    err = capsys.readouterr().err
+    assert "hwpts: warning:" in err and "'timestamp' holds time stamps but no time axis was taken" in err
+    assert main(["validate", str(model), named, "--time", "timestamp"]) == 2
+    assert "sample time 0.005 s (200 Hz) differs" in capsys.readouterr().err
+    empty = write("empty.csv", "time", [s if k != 9 else "" for k, s in enumerate(stamps)])
+    assert main(["validate", str(model), empty]) == 0 and "'time' holds time stamps" in capsys.readouterr().err
+    assert main(["validate", str(model), empty, "--time", "time"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("hwpts: error: --time time: expected ISO 8601 date-times in every row")
+    comma = write("comma.csv", "time", [s.replace(".", ",") for s in stamps], sep=";")
+    assert main(["validate", str(model), comma]) == 2
+    assert "sample time 0.005 s (200 Hz) differs" in capsys.readouterr().err
 
 
 def test_a_time_column_is_found_by_its_conventional_name(tmp_path, capsys):

@@ -105,7 +105,8 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None, uni
     applied silently to data sampled at another rate; ``time_name="none"`` uses the row index.
     """
     from hwpts.dataset import IODataset
-    from hwpts.io.datasets import column_names, csv_datetime_seconds, numeric_share, read_table, temporal_columns
+    from hwpts.io.datasets import (column_names, csv_datetime_seconds, looks_like_datetimes, numeric_share, read_table,
+                                   temporal_columns)
     from hwpts.io.paths import check_input_file
 
     if not str(path).strip():
@@ -115,6 +116,7 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None, uni
         if any(not str(name).strip() for name in names):
             raise ParameterError(f"{flag}: expected a column name, got an empty one")
     signals = [*input_names, output_name]
+    typed = []
     if time_name == NO_TIME:
         candidates = []
     elif time_name is not None:
@@ -134,6 +136,11 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None, uni
     header = set(column_names(path)) if candidates else set()
     stamps = {c: v for c in candidates if c in header and (v := csv_datetime_seconds(path, c)) is not None}
     numeric = [c for c in candidates if c not in stamps]
+    if time_name not in (None, NO_TIME) and time_name not in stamps and time_name in header \
+            and looks_like_datetimes(path, time_name):
+        raise DataError(f"--time {time_name}: expected ISO 8601 date-times in every row, with one kind of time zone "
+                        f"(all naive, or all with a zone or an offset), got a column of dates that does not read as "
+                        f"time stamps (an empty cell, or zones mixed)")
     try:
         columns = read_table(path, [*signals, *numeric])
     except DataError:
@@ -195,6 +202,8 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None, uni
     if timed and time_seconds(tname) != 1.0 and tname not in temporal_columns(path) and tname not in stamps:
         # a column of numbers named in ms (time_ms), minutes, ...; a typed Parquet time is in seconds already
         cols[tname] = np.asarray(cols[tname], dtype=float) * time_seconds(tname)
+    if tname is None and time_name is None and period is None:
+        _warn_unused_time(path, typed, signals)
     if tname is None:
         # time = sample index of the file (keeps the original numbering under --rows), in seconds
         # when a .mat file gives its sample period
@@ -222,6 +231,25 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None, uni
             raise DataError(f"{str(path)!r}: the time column {tname!r} is sampled every {dt:.6g} s but the variable "
                             f"{name!r} says {value:.6g} s; correct one of them, or pass --time none or --time COL")
     return data, dt, hint
+
+
+def _warn_unused_time(path, typed, signals) -> None:
+    """Say where a file holds time stamps that were not taken as its time axis (so that the rate check
+    was skipped): several Parquet columns typed as time, or a CSV column of ISO dates that is not named
+    as a time column or does not read as time stamps (an empty cell, mixed time zones)."""
+    import warnings
+
+    from hwpts.io.datasets import column_names, looks_like_datetimes
+
+    if len(typed) > 1:
+        columns, which = typed, "the one that is the time axis"
+    else:
+        columns = [c for c in column_names(path) if c not in signals and looks_like_datetimes(path, c)]
+        which = "a column of ISO 8601 date-times with no empty cell and one kind of time zone"
+    if columns:
+        warnings.warn(f"{str(path)!r}: {', '.join(map(repr, columns[:3]))} hold{'s' if len(columns) == 1 else ''} "
+                      f"time stamps but no time axis was taken from them, so the sample time is not checked; pass "
+                      f"--time COL ({which})", stacklevel=2)
 
 
 def _mat_sample_time(path, columns) -> tuple[str, float] | None:

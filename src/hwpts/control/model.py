@@ -35,14 +35,14 @@ SIGNAL_UNITS = ("V", "r/min", "r/min")
 
 def _check_units(document: dict, inputs, output) -> None:
     """Refuse a model whose valve input, pump input or output is in another unit than the controllers
-    command and measure (V, r/min, r/min): the units the file records, else those of the names'
-    suffixes (``pump_pressure_pa`` matched "pump" and was read as a speed in r/min)."""
+    command and measure (V, r/min, r/min) by its name's suffix (``pump_pressure_pa`` matched "pump"
+    and was read as a speed in r/min). A unit given as free text (``identify --unit pump=rpm``) is
+    not compared, as ``validate`` does not."""
     from hwpts.units import unit_from_name
 
-    recorded = (document.get("signals") or {}).get("units") or {}
     roles = ("valve input", "pump input", "output")
     for role, name, expected in zip(roles, [*inputs, output], SIGNAL_UNITS):
-        unit = recorded.get(name) or unit_from_name(name)
+        unit = unit_from_name(name)
         if unit is not None and unit != expected:
             raise DataError(f"the model's {role} {name!r} is in {unit}; the controllers read the valve voltage in V, "
                             f"the pump speed and motor A's speed in r/min")

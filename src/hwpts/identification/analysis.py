@@ -162,8 +162,10 @@ class ResidualAnalysis:
             "cross_correlation": {k: [float(x) for x in v] for k, v in self.cross_correlation.items()},
             "outside_share": share,
             "white": None if share["autocorrelation"] is None else share["autocorrelation"] <= 0.05,
-            "independent_of_inputs": None if None in share["cross_correlation"].values()
-            else all(v <= 0.05 for v in share["cross_correlation"].values()),
+            # False where a tested input is correlated; None where the tested ones are not but some
+            # input could not be tested (constant)
+            "independent_of_inputs": False if any(v is not None and v > 0.05 for v in share["cross_correlation"].values())
+            else None if None in share["cross_correlation"].values() else True,
             "untested_inputs": [k for k, v in share["cross_correlation"].items() if v is None],
             "exact": self.exact,
         }

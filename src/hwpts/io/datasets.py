@@ -182,51 +182,59 @@ def temporal_columns(path: str | os.PathLike) -> set[str]:
     return {f.name for f in schema if pa.types.is_temporal(f.type)}
 
 
-def numeric_share(path: str | os.PathLike, column: str) -> float:
-    """The share of a CSV column's non-empty cells that read as numbers (0 for another format or
-    a file without that column): a time column of numbers with one mistyped cell (near 1) is a
-    broken time axis, a column of dates or labels (near 0) is not a time axis at all."""
-    p = Path(path)
-    try:
-        if p.suffix.lower() != ".csv" or not p.is_file():  # (a FIFO would block the read)
-            return 0.0
-    except OSError:  # a name too long, a folder we may not search
-        return 0.0
-    try:
-        text = p.read_text(encoding="utf-8-sig", errors="replace")
-    except OSError:
-        return 0.0
-    rows = [r for r in csv.reader(io.StringIO(text), delimiter=_sniff(p)) if any(c.strip() for c in r)]
-    header = [h.strip() for h in rows[0]] if rows else []
-    if column not in header:
-        return 0.0
-    j = header.index(column)
-    cells = [r[j].strip() for r in rows[1:] if j < len(r) and r[j].strip()]
-    return sum(is_number(c) for c in cells) / len(cells) if cells else 0.0
-
-
-def csv_datetime_seconds(path: str | os.PathLike, column: str) -> np.ndarray | None:
-    """A CSV column of ISO 8601 date-times (``2024-01-01 00:00:00.005``, ``...T...Z``, with an offset,
-    or plain dates) in seconds from its first stamp; None when the file is no CSV, has no such column,
-    or a cell is empty or not such a date-time (a logger's wall-clock stamps as the time axis: read as
-    text they were dropped, and the data compared at the model's rate without a word)."""
+def _csv_cells(path: str | os.PathLike, column: str, first: bool = False) -> list[str] | None:
+    """The stripped cells of a CSV column (with ``first``, the first data row's only, read from the
+    file's first 64 KB); None for another format or a file without that column."""
     p = Path(path)
     try:
         if p.suffix.lower() != ".csv" or not p.is_file():  # (a FIFO would block the read)
             return None
-        text = p.read_text(encoding="utf-8-sig", errors="replace")
-    except OSError:
+        if first:
+            with p.open("rb") as f:
+                text = f.read(65536).decode("utf-8-sig", errors="replace")
+        else:
+            text = p.read_text(encoding="utf-8-sig", errors="replace")
+    except OSError:  # a name too long, a folder we may not search
         return None
     rows = [r for r in csv.reader(io.StringIO(text), delimiter=_sniff(p)) if any(c.strip() for c in r)]
     header = [h.strip() for h in rows[0]] if rows else []
-    if column not in header or len(rows) < 2:
+    if column not in header:
         return None
     j = header.index(column)
-    cells = [r[j].strip() if j < len(r) else "" for r in rows[1:]]
-    if not all(cells) or is_number(cells[0]) or not re.match(r"\d{4}-\d{2}-\d{2}", cells[0]):
+    return [r[j].strip() if j < len(r) else "" for r in rows[1:2 if first else None]]
+
+
+def numeric_share(path: str | os.PathLike, column: str) -> float:
+    """The share of a CSV column's non-empty cells that read as numbers (0 for another format or
+    a file without that column): a time column of numbers with one mistyped cell (near 1) is a
+    broken time axis, a column of dates or labels (near 0) is not a time axis at all."""
+    cells = [c for c in _csv_cells(path, column) or () if c]
+    return sum(is_number(c) for c in cells) / len(cells) if cells else 0.0
+
+
+ISO_DATE = re.compile(r"\d{4}-\d{2}-\d{2}")
+
+
+def looks_like_datetimes(path: str | os.PathLike, column: str) -> bool:
+    """Whether a CSV column's first cell is an ISO 8601 date or date-time (read from the file's head)."""
+    cells = _csv_cells(path, column, first=True)
+    return bool(cells) and bool(ISO_DATE.match(cells[0]))
+
+
+def csv_datetime_seconds(path: str | os.PathLike, column: str) -> np.ndarray | None:
+    """A CSV column of ISO 8601 date-times (``2024-01-01 00:00:00.005``, ``...T...Z``, with an offset,
+    a decimal comma, or plain dates) in seconds from its first stamp; None when the file is no CSV,
+    has no such column, or a cell is empty or not such a date-time (a logger's wall-clock stamps as
+    the time axis: read as text they were dropped, and the data compared at the model's rate without
+    a word)."""
+    if not looks_like_datetimes(path, column):  # (the whole file is read only for a column of dates)
+        return None
+    cells = _csv_cells(path, column)
+    if not cells or not all(cells):
         return None
     import pyarrow as pa
 
+    cells = [re.sub(r"(\d{2}:\d{2}:\d{2}),(\d)", r"\1.\2", c) for c in cells]  # ISO 8601's decimal comma
     for kind in (pa.timestamp("ns"), pa.timestamp("ns", tz="UTC")):  # naive, then with a zone or offset
         try:
             ns = pa.array(cells).cast(kind).cast(pa.int64()).to_numpy(zero_copy_only=False)

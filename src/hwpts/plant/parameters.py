@@ -113,7 +113,7 @@ class PlantParameters:
     inlet fall to -135 kPa in validation case 2, below vacuum; at 1e-6 the pressures stay above -0.2 kPa and
     the speeds differ from 1e-7's by under 0.7 r/min)."""
     droop_gain: float = 0.0
-    """K_droop: prime-mover droop, w_p = w_p,cmd - K_droop * D_p * P_p [(rad/s)/(N m)]; test bed 3.37 (tuned)."""
+    """K_droop: prime-mover droop, w_p = max(w_p,cmd - K_droop * D_p * P_p, 0) [(rad/s)/(N m)]; test bed 3.37 (tuned)."""
     generator_slip_gain: float = 0.0
     """K_g: slope of the induction generator's slip torque on shaft A, T_g = K_g * (w_A - w_sync)
     [N m s/rad] (an option of ours, not in the paper; 0 = off, the paper's 5-state plant)."""
