@@ -288,7 +288,10 @@ def _read_csv_python(p: Path, delimiter: str = ",", columns=None) -> dict[str, n
 
     n = next((k for k, (_, row) in enumerate(numbered) if not remark(row)), len(numbered))
     excel = bool(header) and header[0].lower().startswith("sep=")
-    if header and n and n < len(numbered) and (excel or len(numbered[n][1]) != len(numbered[0][1])):
+    def width(row):  # fields, less trailing empty ones (a delimiter at the end of every data row)
+        return len(row) - next((k for k, cell in enumerate(reversed(row)) if cell.strip()), len(row))
+
+    if header and n and n < len(numbered) and (excel or width(numbered[n][1]) != width(numbered[0][1])):
         what = "Excel's delimiter line" if excel else "a comment"
         raise DataError(f"{str(p)!r} line {numbered[0][0]}: expected the header row of column names, got {what} "
                         f"({delimiter.join(numbered[0][1])[:40]!r}); remove the {n} line{'s' if n > 1 else ''} "
