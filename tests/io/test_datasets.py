@@ -236,3 +236,11 @@ def test_an_unreadable_mat_file_is_named_as_given(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     with pytest.raises(DataError, match=r"^'d/v73.mat': a MATLAB v7.3 \(HDF5\) file"):
         read_table("d/v73.mat")
+
+
+def test_a_utf16_file_is_named_as_such(tmp_path):
+    """Excel's "Unicode text" saved as .csv is UTF-16: said (it was "not a UTF-8 text file")."""
+    path = tmp_path / "excel.csv"
+    path.write_bytes("a\tb\n1\t2\n".encode("utf-16"))  # with its byte-order mark
+    with pytest.raises(DataError, match="a UTF-16 text file; save it as CSV UTF-8"):
+        read_table(path)

@@ -258,7 +258,10 @@ def _read_csv_python(p: Path, delimiter: str = ",", columns=None) -> dict[str, n
     try:
         text = p.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError:
-        raise DataError(f"{str(p)!r}: not a UTF-8 text file, expected CSV") from None
+        with p.open("rb") as f:
+            utf16 = f.read(2) in (b"\xff\xfe", b"\xfe\xff")  # Excel's "Unicode text"
+        raise DataError(f"{str(p)!r}: " + ("a UTF-16 text file; save it as CSV UTF-8" if utf16 else
+                                           "not a UTF-8 text file, expected CSV")) from None
     except OSError as error:
         raise DataError(f"{str(p)!r}: cannot read ({error.strerror or error})") from None
     # (line number, row); a blank line before the first data row or after the last is skipped, but
