@@ -141,6 +141,17 @@ def test_a_model_refuses_data_at_another_sample_time(files, tmp_path, capsys):
     assert json.loads(capsys.readouterr().out)["n_samples"] == 300
 
 
+def _ten_ms_model(tmp_path, capsys, n):
+    """Data of ``n`` samples at 10 ms and a model identified on them: (t, u, y, model path, fit options)."""
+    t, u, y = _second_order(n=n)
+    model = tmp_path / "m.json"
+    write_csv(tmp_path / "slow.csv", {"time_s": t, "u1": u[:, 0], "u2": u[:, 1], "y": y})
+    fit = ["--input", "u1", "--input", "u2", "--output", "y", "--na", "2", "--nb", "1", "--segmentation", "average"]
+    assert main(["identify", str(tmp_path / "slow.csv"), *fit, "--out", str(model)]) == 0
+    capsys.readouterr()
+    return t, u, y, model, fit
+
+
 @pytest.mark.parametrize("form", ["parquet unnamed index", "parquet timestamp", "csv iso", "csv iso zone"])
 def test_time_stamps_are_the_time_axis_by_their_type_or_text(tmp_path, capsys, form):
     """A Parquet column typed as time stamps (pandas' DatetimeIndex written as it is, or named
@@ -149,12 +160,7 @@ def test_time_stamps_are_the_time_axis_by_their_type_or_text(tmp_path, capsys, f
     pa = pytest.importorskip("pyarrow")
     import pyarrow.parquet as pq
 
-    t, u, y = _second_order(n=1000)
-    model = tmp_path / "m.json"
-    write_csv(tmp_path / "slow.csv", {"time_s": t, "u1": u[:, 0], "u2": u[:, 1], "y": y})
-    fit = ["--input", "u1", "--input", "u2", "--output", "y", "--na", "2", "--nb", "1", "--segmentation", "average"]
-    assert main(["identify", str(tmp_path / "slow.csv"), *fit, "--out", str(model)]) == 0
-    capsys.readouterr()
+    t, u, y, model, fit = _ten_ms_model(tmp_path, capsys, 1000)
     stamps = np.datetime64("2024-01-01T00:00:00", "ns") + (t * 5e8).astype("timedelta64[ns]")  # every 5 ms
     if form.startswith("parquet"):
         fast = tmp_path / "fast.parquet"
@@ -177,12 +183,7 @@ def test_time_stamps_not_taken_as_the_time_axis_are_said(tmp_path, capsys):
     """ISO date-times in a column of another name, or that do not all read (an empty cell), leave the
     rate unchecked: a warning says so (it was silent); --time on such a column is refused in a line;
     a decimal comma (ISO 8601 allows it) reads."""
-    t, u, y = _second_order(n=400)
-    model = tmp_path / "m.json"
-    write_csv(tmp_path / "slow.csv", {"time_s": t, "u1": u[:, 0], "u2": u[:, 1], "y": y})
-    fit = ["--input", "u1", "--input", "u2", "--output", "y", "--na", "2", "--nb", "1", "--segmentation", "average"]
-    assert main(["identify", str(tmp_path / "slow.csv"), *fit, "--out", str(model)]) == 0
-    capsys.readouterr()
+    t, u, y, model, fit = _ten_ms_model(tmp_path, capsys, 400)
     stamps = [str(np.datetime64("2024-01-01T00:00:00", "ms") + np.timedelta64(5 * k, "ms")).replace("T", " ")
               for k in range(t.size)]
 
