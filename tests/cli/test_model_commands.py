@@ -122,7 +122,7 @@ def test_too_few_samples(tmp_path, capsys):
     _expect_error(capsys, ["identify", str(path), "--input", "a", "--input", "b", "--output", "y", "--na", "5",
                            "--nb", "4", "--nk", "0", "--out", str(out)],
                   "na=5, nb=4, nk=0 needs at least 19 samples (5 initial conditions + 14 parameters); "
-                  f"{path} has 7 rows", out)
+                  f"{str(path)!r} has 7 rows", out)
 
 
 def test_nan_in_data(tmp_path, capsys):

@@ -668,7 +668,7 @@ def cmd_identify(args) -> int:
         structure = RegressorStructure.create(fixed["output_order"], fixed["input_order"], fixed["input_delay"],
                                               len(args.input), True, args.input, args.output,
                                               given_powers)
-        structure.check_length(data.n_samples, what=_selection(args, str(args.data)))
+        structure.check_length(data.n_samples, what=_selection(args, repr(str(args.data))))
     hyperplanes = [Hyperplane.parse(h) for h in args.hyperplane]
     segmentation = args.segmentation
     if hyperplanes and segmentation is None:
