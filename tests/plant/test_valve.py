@@ -81,3 +81,16 @@ def test_orifice_law_paper_eq_14_and_check_valve():
     assert abs(orifice_flow(area, -1e5, p)) < 1e-3 * exact  # one-way
     q = orifice_flow(area, np.linspace(-1e4, 1e4, 101), p)
     assert np.all(np.diff(q) >= 0)  # monotone through the origin, no jump
+
+
+def test_the_make_up_valve_opens_only_under_suction():
+    # docs/plant.md 2.8: no make-up flow at a positive pressure (a smooth max fed an idle chamber from
+    # the tank, uphill), continuous with its slope where it opens
+    from hwpts.plant.valve import MAKEUP_ONSET_PA, makeup_shape, makeup_shape_derivative
+
+    w = MAKEUP_ONSET_PA
+    assert makeup_shape(-5000.0, w) == 0.0 and makeup_shape(0.0, w) == 0.0
+    assert makeup_shape(w, w) == pytest.approx(w / 2) and makeup_shape(3 * w, w) == pytest.approx(2.5 * w)
+    for s in (0.3 * w, w, 2 * w):
+        fd = (makeup_shape(s + 1e-3, w) - makeup_shape(s - 1e-3, w)) / 2e-3
+        assert makeup_shape_derivative(s, w) == pytest.approx(fd, rel=1e-6)

@@ -16,7 +16,8 @@ import numpy as np
 
 from hwpts.plant.parameters import PARAMETER_INDEX as _I
 from hwpts.plant.parameters import PlantParameters
-from hwpts.plant.valve import MAKEUP_SMOOTHING_PA, orifice_shape, orifice_shape_derivative, smooth_max0, smooth_max0_derivative
+from hwpts.plant.valve import (MAKEUP_ONSET_PA, makeup_shape, makeup_shape_derivative, orifice_shape,
+                              orifice_shape_derivative, smooth_max0, smooth_max0_derivative)
 
 N_STATES = 5
 STATE_NAMES = ("pump_pressure_pa", "motor_a_pressure_pa", "motor_b_pressure_pa", "motor_a_speed", "motor_b_speed")
@@ -93,9 +94,9 @@ def rhs_into(x, h, wp_cmd, p, dx):
     qp = p[_DP] * pump_speed_actual(pp, wp_cmd, p) - p[_CSP] * pp
     qrv = p[_KRV] * smooth_max0(pp - p[_PRV], eps)
     kmu = p[_KMU]
-    dx[0] = p[_BETA] / p[_VP] * (qp - qa - qb - qrv + kmu * smooth_max0(-pp, MAKEUP_SMOOTHING_PA))
-    dx[1] = p[_BETA] / p[_VA] * (qa - p[_DMA] * wa - p[_CSA] * pa + kmu * smooth_max0(-pa, MAKEUP_SMOOTHING_PA))
-    dx[2] = p[_BETA] / p[_VB] * (qb - p[_DMB] * wb - p[_CSB] * pb + kmu * smooth_max0(-pb, MAKEUP_SMOOTHING_PA))
+    dx[0] = p[_BETA] / p[_VP] * (qp - qa - qb - qrv + kmu * makeup_shape(-pp, MAKEUP_ONSET_PA))
+    dx[1] = p[_BETA] / p[_VA] * (qa - p[_DMA] * wa - p[_CSA] * pa + kmu * makeup_shape(-pa, MAKEUP_ONSET_PA))
+    dx[2] = p[_BETA] / p[_VB] * (qb - p[_DMB] * wb - p[_CSB] * pb + kmu * makeup_shape(-pb, MAKEUP_ONSET_PA))
     dx[3] = (p[_DMA] * pa - p[_BA] * wa - p[_TCA] * math.tanh(wa / p[_WS]) - p[_KG] * (wa - p[_WSYNC])) / p[_JA]
     dx[4] = (p[_DMB] * pb - p[_BB] * wb - p[_TCB] * math.tanh(wb / p[_WS])) / p[_JB]
 
@@ -129,14 +130,14 @@ def jacobian_into(x, h, wp_cmd, p, jac, dfdh):
     for i in range(5):
         for j in range(5):
             jac[i, j] = 0.0
-    jac[0, 0] = kp * (dqp_dpp - ga - gb - dqrv_dpp - kmu * smooth_max0_derivative(-pp, MAKEUP_SMOOTHING_PA))
+    jac[0, 0] = kp * (dqp_dpp - ga - gb - dqrv_dpp - kmu * makeup_shape_derivative(-pp, MAKEUP_ONSET_PA))
     jac[0, 1] = kp * ga
     jac[0, 2] = kp * gb
     jac[1, 0] = ka * ga
-    jac[1, 1] = ka * (-ga - p[_CSA] - kmu * smooth_max0_derivative(-pa, MAKEUP_SMOOTHING_PA))
+    jac[1, 1] = ka * (-ga - p[_CSA] - kmu * makeup_shape_derivative(-pa, MAKEUP_ONSET_PA))
     jac[1, 3] = -ka * p[_DMA]
     jac[2, 0] = kb * gb
-    jac[2, 2] = kb * (-gb - p[_CSB] - kmu * smooth_max0_derivative(-pb, MAKEUP_SMOOTHING_PA))
+    jac[2, 2] = kb * (-gb - p[_CSB] - kmu * makeup_shape_derivative(-pb, MAKEUP_ONSET_PA))
     jac[2, 4] = -kb * p[_DMB]
     ta = math.tanh(wa / p[_WS])
     tb = math.tanh(wb / p[_WS])

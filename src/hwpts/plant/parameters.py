@@ -106,12 +106,13 @@ class PlantParameters:
     """w_s: width of the tanh standing in for sgn(w) in the load torque [rad/s] (numerical)."""
     relief_pressure: float = 6.9e6
     """P_rv: relief valve setting on the pump line [Pa] (assumed)."""
-    relief_gain: float = 1.0e-10
-    """K_rv: relief valve flow gain [m^3/(s Pa)] (assumed)."""
+    relief_gain: float = 1.0e-9
+    """K_rv: relief valve flow gain [m^3/(s Pa)] (assumed: full pump flow at 3000 r/min passes 0.8 MPa above the
+    setting, 11 %; 1e-10 needed 7.8 MPa, and a valve step peaked at 11.2 MPa)."""
     makeup_gain: float = 1.0e-6
     """K_mu: make-up check valve gain keeping pressures >= 0 [m^3/(s Pa)] (numerical: 1e-9 let motor A's
-    inlet fall to -135 kPa in validation case 2, below vacuum; at 1e-6 the pressures stay above -0.2 kPa and
-    the speeds differ from 1e-7's by under 0.7 r/min)."""
+    inlet fall to -135 kPa in validation case 2, below vacuum; at 1e-6 the pressures stay above -1.1 kPa,
+    the opening over :data:`~hwpts.plant.valve.MAKEUP_ONSET_PA` included, at full flow)."""
     droop_gain: float = 0.0
     """K_droop: prime-mover droop, w_p = max(w_p,cmd - K_droop * D_p * P_p, 0) [(rad/s)/(N m)]; test bed 3.37 (tuned)."""
     generator_slip_gain: float = 0.0

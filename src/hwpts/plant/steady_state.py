@@ -25,7 +25,9 @@ from hwpts.plant.dynamics import N_STATES, pump_speed_actual, pump_speed_slope
 from hwpts.plant.parameters import PARAMETER_INDEX as _I
 from hwpts.plant.parameters import PlantParameters
 from hwpts.plant.valve import (
-    MAKEUP_SMOOTHING_PA,
+    MAKEUP_ONSET_PA,
+    makeup_shape,
+    makeup_shape_derivative,
     orifice_shape,
     orifice_shape_derivative,
     play_operator,
@@ -79,8 +81,8 @@ def _branch(w, pp, area, opening, dm, cs, damping, torque, ws, c, pcr, eps, kmu,
     dp = pp - pm - opening
     q = c * area * orifice_shape(dp, pcr, eps)
     dq = c * area * orifice_shape_derivative(dp, pcr, eps)
-    mu = kmu * smooth_max0(-pm, MAKEUP_SMOOTHING_PA)
-    dmu = kmu * smooth_max0_derivative(-pm, MAKEUP_SMOOTHING_PA)
+    mu = kmu * makeup_shape(-pm, MAKEUP_ONSET_PA)
+    dmu = kmu * makeup_shape_derivative(-pm, MAKEUP_ONSET_PA)
     out[0] = q + mu - dm * w - cs * pm
     out[1] = -dq * dpm - dmu * dpm - dm - cs * dpm
     out[2] = dq
@@ -164,9 +166,9 @@ def _pump_balance(pp, h, wp_cmd, p, speeds, work):
     qp = p[_PUMP_DISPLACEMENT] * pump_speed_actual(pp, wp_cmd, p) - p[_PUMP_LEAKAGE] * pp
     qrv = p[_RELIEF_GAIN] * smooth_max0(pp - p[_RELIEF_PRESSURE], eps)
     work[0] = (p[_PUMP_DISPLACEMENT] * pump_speed_slope(pp, wp_cmd, p) - p[_PUMP_LEAKAGE]
-               - kmu * smooth_max0_derivative(-pp, MAKEUP_SMOOTHING_PA) - dqa - dqb
+               - kmu * makeup_shape_derivative(-pp, MAKEUP_ONSET_PA) - dqa - dqb
                - p[_RELIEF_GAIN] * smooth_max0_derivative(pp - p[_RELIEF_PRESSURE], eps))
-    return qp + kmu * smooth_max0(-pp, MAKEUP_SMOOTHING_PA) - qa - qb - qrv
+    return qp + kmu * makeup_shape(-pp, MAKEUP_ONSET_PA) - qa - qb - qrv
 
 
 @numba.njit(cache=True)
