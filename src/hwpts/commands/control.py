@@ -208,6 +208,7 @@ def study_command(args) -> int:
     import numpy as np
 
     from hwpts.control.controllers import parse_names
+    from hwpts.control.scenarios import scenario_duration
     from hwpts.control.study import PLANT_TOLERANCES, TARGETS, run_study
     from hwpts.reporting.summary import run_info
     from hwpts.errors import DataError, ParameterError
@@ -249,7 +250,7 @@ def study_command(args) -> int:
                "seed": args.seed, "controllers": result.summary, "targets": TARGETS,
                "plant_tolerances": PLANT_TOLERANCES, "model": {"source": source, "sample_time_s": sample_time,
                                                                "hysteresis_half_width_v": half_width},
-               "duration_s": _duration_of(args.scenario, args.duration), "scheduler": args.scheduler or "local cluster",
+               "duration_s": round(scenario_duration(args.scenario, args.duration), 6), "scheduler": args.scheduler or "local cluster",
                "run": run_info(args.seed, getattr(args, "command_line", None)), "timings_s": {}}
     if added_pi:
         print("control study: pi added to --controllers (the baseline of the 30 % RMS target)", file=sys.stderr)
@@ -278,14 +279,6 @@ def study_command(args) -> int:
     print(f"{args.plants} plants x {args.seeds} seeds x {len(names)} controllers on {summary['scheduler']}: "
           f"wrote {args.out}/results.parquet and summary.json in {summary['timings_s']['total']:.1f} s")
     return 0
-
-
-def _duration_of(scenario: str, duration) -> float:
-    """The record length [s] a scenario runs for with ``--duration`` (None: the scenario's own)."""
-    from hwpts.control.scenarios import build_scenario
-
-    time = build_scenario(scenario, 0, duration=duration).time
-    return round(float(time[-1] - time[0]), 6)
 
 
 def run_command(args) -> int:

@@ -112,10 +112,11 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None, uni
     if not str(path).strip():
         raise ParameterError("DATA: expected a data file path, got an empty string")
     check_input_file(path, expected="a .csv, .parquet or .mat file")  # the file's own problem first
-    for flag, names in (("--input", input_names), ("--output", [output_name])):
-        if any(not str(name).strip() for name in names):
+    for flag, given in (("--input", input_names), ("--output", [output_name])):
+        if any(not str(name).strip() for name in given):
             raise ParameterError(f"{flag}: expected a column name, got an empty one")
     signals = [*input_names, output_name]
+    names, temporal = column_names(path), temporal_columns(path)  # (a CSV's header, a Parquet schema: read once)
     typed = []
     if time_name == NO_TIME:
         candidates = []
@@ -124,19 +125,18 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None, uni
     else:
         # (none from a .mat file, not read twice for its names: its time is a vector of the
         # conventional names or its Ts)
-        others = [c for c in column_names(path) if TIME_PATTERN.fullmatch(c) and c not in TIME_COLUMNS]
+        others = [c for c in names if TIME_PATTERN.fullmatch(c) and c not in TIME_COLUMNS]
         candidates = [c for c in (*TIME_COLUMNS, *others) if c not in signals]
         # a Parquet file's one column typed as time, whatever its name (pandas writes a DataFrame's
         # time index as __index_level_0__ or under the index's name: 5 ms data were compared with a
         # 10 ms model without a word)
-        typed = sorted(temporal_columns(path) - set(signals))
+        typed = sorted(temporal - set(signals))
         if len(typed) == 1 and typed[0] not in candidates:
             candidates.append(typed[0])
     # a CSV time column of ISO 8601 date-times (a logger's wall clock), in seconds from its first stamp
-    header = set(column_names(path)) if candidates else set()
-    stamps = {c: v for c in candidates if c in header and (v := csv_datetime_seconds(path, c)) is not None}
+    stamps = {c: v for c in candidates if c in names and (v := csv_datetime_seconds(path, c)) is not None}
     numeric = [c for c in candidates if c not in stamps]
-    if time_name not in (None, NO_TIME) and time_name not in stamps and time_name in header \
+    if time_name not in (None, NO_TIME) and time_name not in stamps and time_name in names \
             and looks_like_datetimes(path, time_name):
         raise DataError(f"--time {time_name}: expected ISO 8601 date-times in every row, with one kind of time zone "
                         f"(all naive, or all with a zone or an offset), got a column of dates that does not read as "
@@ -199,11 +199,11 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None, uni
     how = "its name" if tname in TIME_COLUMNS or TIME_PATTERN.fullmatch(str(tname)) else "its type"
     hint = f" ({tname!r} is taken as the time column by {how}; --time none uses the sample index)" if detected else ""
     timed = tname is not None
-    if timed and time_seconds(tname) != 1.0 and tname not in temporal_columns(path) and tname not in stamps:
+    if timed and time_seconds(tname) != 1.0 and tname not in temporal and tname not in stamps:
         # a column of numbers named in ms (time_ms), minutes, ...; a typed Parquet time is in seconds already
         cols[tname] = np.asarray(cols[tname], dtype=float) * time_seconds(tname)
     if tname is None and time_name is None and period is None:
-        _warn_unused_time(path, typed, signals)
+        _warn_unused_time(path, names, typed, signals)
     if tname is None:
         # time = sample index of the file (keeps the original numbering under --rows), in seconds
         # when a .mat file gives its sample period
@@ -233,18 +233,18 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None, uni
     return data, dt, hint
 
 
-def _warn_unused_time(path, typed, signals) -> None:
+def _warn_unused_time(path, names, typed, signals) -> None:
     """Say where a file holds time stamps that were not taken as its time axis (so that the rate check
     was skipped): several Parquet columns typed as time, or a CSV column of ISO dates that is not named
     as a time column or does not read as time stamps (an empty cell, mixed time zones)."""
     import warnings
 
-    from hwpts.io.datasets import column_names, looks_like_datetimes
+    from hwpts.io.datasets import looks_like_datetimes
 
     if len(typed) > 1:
         columns, which = typed, "the one that is the time axis"
     else:
-        columns = [c for c in column_names(path) if c not in signals and looks_like_datetimes(path, c)]
+        columns = [c for c in names if c not in signals and looks_like_datetimes(path, c)]
         which = "a column of ISO 8601 date-times with no empty cell and one kind of time zone"
     if columns:
         warnings.warn(f"{str(path)!r}: {', '.join(map(repr, columns[:3]))} hold{'s' if len(columns) == 1 else ''} "

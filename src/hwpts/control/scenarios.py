@@ -64,6 +64,16 @@ def test_bed_with_generator() -> PlantParameters:
                                               generator_synchronous_speed=SETPOINT_RPM * math.pi / 30.0)
 
 
+DEFAULT_DURATION_S = {"setpoint-step": 20.0, "pump-step": 32.0, "load-step": 32.0, "turbulence": 600.0, "low-wind": 60.0}
+"""Each scenario's own record length [s] (the turbulence scenarios share one)."""
+
+
+def scenario_duration(name: str, duration: float | None = None) -> float:
+    """The record length [s] scenario ``name`` runs for: ``duration`` on the sample grid, or its own."""
+    own = DEFAULT_DURATION_S["turbulence" if name.startswith("turbulence-") else name]
+    return float(_grid(duration or own)[-1])
+
+
 def _grid(duration):
     return np.arange(int(round(duration / SAMPLE_TIME_S)) + 1) * SAMPLE_TIME_S
 
@@ -81,33 +91,33 @@ def build_scenario(name: str, seed: int = 0, setpoint: float = SETPOINT_RPM, dur
         raise ParameterError(f"unknown scenario {name!r}; expected one of {', '.join(SCENARIO_NAMES)}")
     turbine = Turbine()
     if name == "setpoint-step":
-        t = _grid(duration or 20.0)
+        t = _grid(duration or DEFAULT_DURATION_S["setpoint-step"])
         sp = _steps(t, setpoint, [(4.0, setpoint * 1.05), (12.0, setpoint)])
         return Scenario(name, f"set-point steps {setpoint:g} -> {setpoint * 1.05:g} -> {setpoint:g} r/min at 4 s and "
                               f"12 s, pump at {NOMINAL_PUMP_RPM:g} r/min", t, sp, np.full(t.size, NOMINAL_PUMP_RPM),
                         np.ones(t.size), "setpoint", (4.0, 12.0))
     if name == "pump-step":
-        t = _grid(duration or 32.0)
+        t = _grid(duration or DEFAULT_DURATION_S["pump-step"])
         w = _steps(t, NOMINAL_PUMP_RPM, [(4.0, NOMINAL_PUMP_RPM + 200), (11.0, NOMINAL_PUMP_RPM),
                                          (18.0, NOMINAL_PUMP_RPM - 200), (25.0, NOMINAL_PUMP_RPM)])
         return Scenario(name, f"pump-speed command steps of +-200 r/min about {NOMINAL_PUMP_RPM:g} r/min every 7 s",
                         t, np.full(t.size, setpoint), w, np.ones(t.size), "disturbance", (4.0, 11.0, 18.0, 25.0))
     if name == "load-step":
-        t = _grid(duration or 32.0)
+        t = _grid(duration or DEFAULT_DURATION_S["load-step"])
         load = _steps(t, 1.0, [(4.0, 1.3), (11.0, 1.0), (18.0, 0.7), (25.0, 1.0)])
         return Scenario(name, "electric load steps of +30 % and -30 % on the generator (shaft A) every 7 s, pump at "
                               f"{NOMINAL_PUMP_RPM:g} r/min", t, np.full(t.size, setpoint), np.full(t.size, NOMINAL_PUMP_RPM),
                         load, "disturbance", (4.0, 11.0, 18.0, 25.0))
     if name.startswith("turbulence-"):
         cls = name[-1].upper()
-        t = _grid(duration or 600.0)
+        t = _grid(duration or DEFAULT_DURATION_S["turbulence"])
         wind = kaimal_wind(t[-1], SAMPLE_TIME_S, TURBULENCE_MEAN_WIND, cls, seed=seed)
         w = turbine.pump_speed_command(wind, SAMPLE_TIME_S)
         return Scenario(name, f"IEC 61400-1 class {cls} turbulence (Kaimal), mean wind {TURBULENCE_MEAN_WIND:g} m/s, "
                               f"{t[-1]:g} s, seed {seed}", t, np.full(t.size, setpoint), w, np.ones(t.size), "turbulence",
                         (), wind)
     # low-wind: the wind falls until 1000 r/min is out of reach, stays low, and comes back
-    t = _grid(duration or 60.0)
+    t = _grid(duration or DEFAULT_DURATION_S["low-wind"])
     v_hi = TURBULENCE_MEAN_WIND
     v_lo = 6.0
     wind = np.interp(t, [0, 8, 14, 34, 40, t[-1]], [v_hi, v_hi, v_lo, v_lo, v_hi, v_hi])
