@@ -11,7 +11,7 @@ def cmd_residuals(args) -> int:
     from hwpts.commands.model import _model_and_data
     from hwpts.identification.analysis import residual_analysis
 
-    model, data = _model_and_data(args)
+    model, data, _ = _model_and_data(args)
     model.structure_.check_length(data.n_samples, what="DATA")
     try:
         analysis = residual_analysis(model, data.inputs, data.output, lags=args.lags, confidence=args.confidence)

@@ -919,7 +919,8 @@ def _check_mapped_units(model, inputs, output) -> None:
 
 
 def _model_and_data(args):
-    """The model and the data mapped onto its signals (by name, or by --input/--output), at its rate."""
+    """``(model, data, timed)``: the model, the data mapped onto its signals (by name, or by
+    --input/--output) at its rate, and whether their time is in seconds (else the sample index)."""
     from hwpts.io.models import load_model
 
     model = load_model(args.model)
@@ -941,13 +942,12 @@ def _model_and_data(args):
     st.check_length(data.n_samples, what=_selection(args, repr(str(args.data))))
     # the data's time is in seconds when they have a time column or the model a sample time (else it
     # is the sample index): a figure's axis says which (it said "sample" under the data's seconds)
-    args.time_in_seconds = dt is not None or getattr(model, "sample_time_", None) is not None
-    return model, data
+    return model, data, dt is not None or getattr(model, "sample_time_", None) is not None
 
 
 def cmd_validate(args) -> int:
     """``hwpts validate``: free-run and one-step fit of MODEL on DATA (text or JSON), optionally a figure."""
-    model, data = _model_and_data(args)
+    model, data, timed = _model_and_data(args)
     m = model.structure_.max_lag
     if data.n_samples > m and np.ptp(data.output[m:]) == 0:
         raise DataError(f"{_selection(args, repr(str(args.data)))}: the output {data.output_name!r} is constant "
@@ -955,7 +955,7 @@ def cmd_validate(args) -> int:
                         f"(`hwpts predict` simulates the model on these data)")
     result = _validate_numbers(model, data)
     if args.plot is not None:
-        _write_validation_plot(model, data, result, args)
+        _write_validation_plot(model, data, result, args, timed)
         result["plot"] = str(args.plot)
     if args.json:
         print(json_text(result))
@@ -976,13 +976,12 @@ def cmd_validate(args) -> int:
     return 0
 
 
-def _write_validation_plot(model, data, result, args):
+def _write_validation_plot(model, data, result, args, timed: bool):
     from hwpts.io.atomic import write_bytes_atomic
     from hwpts.reporting.analysis import validation_figure
 
     sim = model.simulate(data.inputs, data.output)
     units = getattr(model, "units_", {}) or {}
-    timed = getattr(args, "time_in_seconds", False)
     png = validation_figure(
         data.time, data.output, sim.output, sim.regions, n_initial=model.structure_.max_lag,
         output_name=model.structure_.output_name, unit=units.get(model.structure_.output_name),
@@ -997,7 +996,7 @@ def cmd_predict(args) -> int:
 
     from hwpts.io.datasets import is_stdout, write_table
 
-    model, data = _model_and_data(args)
+    model, data, _ = _model_and_data(args)
     model.structure_.check_length(data.n_samples, what="DATA")
     name = data.output_name
     written = ("time_s", f"{name}_predicted", "region")

@@ -152,10 +152,11 @@ def dumps_model(model) -> str:
     text = json.dumps(doc, indent=1, allow_nan=False) + "\n"
     try:
         model_from_dict(json.loads(text))
+    except ModelNumberError as error:
+        raise DataError(f"the fitted model cannot be written as a model file: {error}; rescale the signals so "
+                        f"that the model's parameters stay within +-{MAX_MODEL_NUMBER:.0e}") from None
     except HwptsError as error:
-        scale = (f"; rescale the signals so that the model's parameters stay within +-{MAX_MODEL_NUMBER:.0e}"
-                 if "beyond" in str(error) else "")
-        raise DataError(f"the fitted model cannot be written as a model file: {error}{scale}") from None
+        raise DataError(f"the fitted model cannot be written as a model file: {error}") from None
     return text
 
 
@@ -230,6 +231,10 @@ MAX_MODEL_NUMBER = 1e100  # beyond it a parameter or boundary overflows in the f
 MAX_LAG_WITHOUT_RECORD = 1000  # largest lag of a model file that does not say its record's length
 
 
+class ModelNumberError(DataError):
+    """A model file's number beyond +-:data:`MAX_MODEL_NUMBER` (:func:`dumps_model` adds the remedy)."""
+
+
 def _has_leaf(value, kind: type) -> bool:
     """Whether ``value`` (nested lists) holds a ``kind`` (``bool``, ``str``) anywhere."""
     if isinstance(value, kind):
@@ -249,7 +254,8 @@ def _numbers(value, shape_desc: str, where: str) -> np.ndarray:
     if not np.all(np.isfinite(arr)):
         raise DataError(f"{where} holds a non-finite number")
     if arr.size and np.max(np.abs(arr)) > MAX_MODEL_NUMBER:
-        raise DataError(f"{where} holds {arr.flat[int(np.argmax(np.abs(arr)))]:.3g}, beyond +-{MAX_MODEL_NUMBER:.0e}")
+        raise ModelNumberError(f"{where} holds {arr.flat[int(np.argmax(np.abs(arr)))]:.3g}, "
+                               f"beyond +-{MAX_MODEL_NUMBER:.0e}")
     return arr
 
 
