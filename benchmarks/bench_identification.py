@@ -105,7 +105,6 @@ def bench_small_systems(rows):
 
 def bench_system5(n, pyparc, lines, seed=0):
     from hwpts.identification import PWARX, region_accuracy
-    from hwpts.identification.metrics import best_permutation
     from hwpts.identification.regressors import RegressorStructure
     from hwpts.identification.synthetic import make_system
 
