@@ -259,12 +259,20 @@ def _print_actuator():
     rho_train = spearmanr(test[ok], train[ok]).statistic
     print(f"   rank correlation with the test fit over the {int(ok.sum())} models scored everywhere: "
           f"held-out blocks (the search's score) {rho_held:.2f}, free run of the whole training part {rho_train:.2f}")
-    top = np.argsort(-np.where(np.isfinite(held), held, -np.inf))[:5]
-    print("   the five best held-out fits and their test fits:")
-    for i in top:
+    def show(i, score, name):
         p = rows[i][0]
-        print(f"   held out {held[i]:6.2f}  test {test[i]:6.2f}  na {p['output_order']} nb {p['input_order']} "
+        print(f"   {name} {score[i]:6.2f}  test {test[i]:6.2f}  na {p['output_order']} nb {p['input_order']} "
               f"nk {p['input_delay']} {p['segmentation']} {p['n_regions']}{' polished' if p['polish'] else ''}")
+
+    print("   the five best held-out fits and their test fits:")
+    for i in np.argsort(-np.where(np.isfinite(held), held, -np.inf))[:5]:
+        show(i, held, "held out")
+    # the polish fits the whole-record free run itself: only least squares' runs say something there
+    for polished in (False, True):
+        print(f"   the three best whole-record free runs of the {'polished' if polished else 'least-squares'} models:")
+        mine = np.array([r[0]["polish"] == polished for r in rows]) & np.isfinite(train)
+        for i in np.argsort(-np.where(mine, train, -np.inf))[:3]:
+            show(i, train, "training")
 
 
 def main(argv=None) -> int:
