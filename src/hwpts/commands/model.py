@@ -861,8 +861,9 @@ def _merged(kind: str, details: list[dict]) -> str:
     if kind == "dropped":
         counts = [details[0]["before"]] + [d["after"] for d in details]
         first, last = counts[0], counts[-1]
-        return (f"{first - last} of {first} regions received no training sample and were dropped "
-                f"({' -> '.join(str(c) for c in counts)}); the model has {last} regions")
+        from hwpts.identification.partition.learner import dropped_message
+
+        return dropped_message(first, last, f" ({' -> '.join(str(c) for c in counts)})")
     last = {d["region"]: d for d in details}  # a region warned twice: its last fit's numbers
     regions = sorted(last)
     names = ", ".join(str(r) for r in regions)

@@ -29,6 +29,14 @@ SEPARABLE_C = 1e8  # the classifier's regularisation on labels it can separate e
 POOL = 20  # the refinement rounds draw their classifier rows from at most POOL x classifier_rows rows
 
 
+def dropped_message(before: int, after: int, path: str = "") -> str:
+    """The warning's words for ``before - after`` of ``before`` regions dropped (``path``: the
+    counts in between, `` (26 -> 11 -> 8)``)."""
+    gone = before - after
+    return (f"{gone} of {before} regions received no training sample and {'was' if gone == 1 else 'were'} "
+            f"dropped{path}; the model has {after} region{'' if after == 1 else 's'}")
+
+
 def drop_empty_regions(labels, s):
     """Labels renumbered without the regions that hold no row, and the number left (with a
     :class:`~hwpts.identification.local_models.RegionWarning` when some were dropped)."""
@@ -38,9 +46,8 @@ def drop_empty_regions(labels, s):
     keep = np.flatnonzero(counts > 0)
     if keep.size == s:
         return labels, s
-    warnings.warn(RegionWarning(
-        f"{s - keep.size} of {s} regions received no training sample and were dropped; "
-        f"the model has {keep.size} regions", "dropped", before=int(s), after=int(keep.size)), stacklevel=3)
+    warnings.warn(RegionWarning(dropped_message(s, keep.size), "dropped", before=int(s), after=int(keep.size)),
+                  stacklevel=3)
     remap = np.full(s, -1)
     remap[keep] = np.arange(keep.size)
     return remap[labels], int(keep.size)
