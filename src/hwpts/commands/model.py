@@ -105,7 +105,7 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None, uni
     applied silently to data sampled at another rate; ``time_name="none"`` uses the row index.
     """
     from hwpts.dataset import IODataset
-    from hwpts.io.datasets import (column_names, csv_datetime_seconds, looks_like_datetimes, numeric_share, read_table,
+    from hwpts.io.datasets import (column_names, csv_datetime_seconds, datetime_columns, numeric_share, read_table,
                                    temporal_columns)
     from hwpts.io.paths import check_input_file
 
@@ -117,6 +117,7 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None, uni
             raise ParameterError(f"{flag}: expected a column name, got an empty one")
     signals = [*input_names, output_name]
     names, temporal = column_names(path), temporal_columns(path)  # (a CSV's header, a Parquet schema: read once)
+    dated = datetime_columns(path)  # (a CSV's first row, read once)
     typed = []
     if time_name == NO_TIME:
         candidates = []
@@ -134,10 +135,9 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None, uni
         if len(typed) == 1 and typed[0] not in candidates:
             candidates.append(typed[0])
     # a CSV time column of ISO 8601 date-times (a logger's wall clock), in seconds from its first stamp
-    stamps = {c: v for c in candidates if c in names and (v := csv_datetime_seconds(path, c)) is not None}
+    stamps = {c: v for c in candidates if c in dated and (v := csv_datetime_seconds(path, c)) is not None}
     numeric = [c for c in candidates if c not in stamps]
-    if time_name not in (None, NO_TIME) and time_name not in stamps and time_name in names \
-            and looks_like_datetimes(path, time_name):
+    if time_name not in (None, NO_TIME) and time_name not in stamps and time_name in dated:
         raise DataError(f"--time {time_name}: expected ISO 8601 date-times in every row, with one kind of time zone "
                         f"(all naive, or all with a zone or an offset), got a column of dates that does not read as "
                         f"time stamps (an empty cell, or zones mixed)")
@@ -203,7 +203,7 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None, uni
         # a column of numbers named in ms (time_ms), minutes, ...; a typed Parquet time is in seconds already
         cols[tname] = np.asarray(cols[tname], dtype=float) * time_seconds(tname)
     if tname is None and time_name is None and period is None:
-        _warn_unused_time(path, names, typed, signals)
+        _warn_unused_time(path, names, typed, signals, dated)
     if tname is None:
         # time = sample index of the file (keeps the original numbering under --rows), in seconds
         # when a .mat file gives its sample period
@@ -233,18 +233,17 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None, uni
     return data, dt, hint
 
 
-def _warn_unused_time(path, names, typed, signals) -> None:
+def _warn_unused_time(path, names, typed, signals, dated) -> None:
     """Say where a file holds time stamps that were not taken as its time axis (so that the rate check
     was skipped): several Parquet columns typed as time, or a CSV column of ISO dates that is not named
-    as a time column or does not read as time stamps (an empty cell, mixed time zones)."""
+    as a time column or does not read as time stamps (an empty cell, mixed time zones); ``dated``:
+    the CSV columns of dates (:func:`hwpts.io.datasets.datetime_columns`)."""
     import warnings
-
-    from hwpts.io.datasets import looks_like_datetimes
 
     if len(typed) > 1:
         columns, which = typed, "the one that is the time axis"
     else:
-        columns = [c for c in names if c not in signals and looks_like_datetimes(path, c)]
+        columns = [c for c in names if c not in signals and c in dated]
         which = "a column of ISO 8601 date-times with no empty cell and one kind of time zone"
     if columns:
         warnings.warn(f"{str(path)!r}: {', '.join(map(repr, columns[:3]))} hold{'s' if len(columns) == 1 else ''} "

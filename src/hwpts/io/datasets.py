@@ -9,6 +9,7 @@ from __future__ import annotations
 import csv
 import functools
 import io
+import itertools
 import os
 import re
 from collections.abc import Mapping
@@ -182,26 +183,33 @@ def temporal_columns(path: str | os.PathLike) -> set[str]:
     return {f.name for f in schema if pa.types.is_temporal(f.type)}
 
 
-def _csv_cells(path: str | os.PathLike, column: str, first: bool = False) -> list[str] | None:
-    """The stripped cells of a CSV column (with ``first``, the first data row's only, read from the
-    file's first 64 KB); None for another format or a file without that column."""
+def _csv_rows(path: str | os.PathLike, first: bool = False) -> tuple[list[str], list[list[str]]] | None:
+    """``(header, data rows)`` of a CSV file, the header's names stripped and blank rows skipped (with
+    ``first``, the first data row only, read from the file's first 64 KB); None for another format."""
     p = Path(path)
     try:
         if p.suffix.lower() != ".csv" or not p.is_file():  # (a FIFO would block the read)
             return None
-        if first:
-            with p.open("rb") as f:
-                text = f.read(65536).decode("utf-8-sig", errors="replace")
-        else:
-            text = p.read_text(encoding="utf-8-sig", errors="replace")
+        with p.open("rb") as f:
+            raw = f.read(65536) if first else f.read()
     except OSError:  # a name too long, a folder we may not search
         return None
-    rows = [r for r in csv.reader(io.StringIO(text), delimiter=_sniff(p)) if any(c.strip() for c in r)]
-    header = [h.strip() for h in rows[0]] if rows else []
-    if column not in header:
+    text = io.StringIO(raw.decode("utf-8-sig", errors="replace"), newline=None)  # universal newlines, as read_text
+    reader = csv.reader(text, delimiter=_sniff(p, raw[:65536]))
+    try:
+        rows = [r for r in itertools.islice((r for r in reader if any(c.strip() for c in r)), 2 if first else None)]
+    except csv.Error:  # not a table: the reader of the data says what is wrong with it
         return None
-    j = header.index(column)
-    return [r[j].strip() if j < len(r) else "" for r in rows[1:2 if first else None]]
+    return ([h.strip() for h in rows[0]], rows[1:]) if rows else None
+
+
+def _csv_cells(path: str | os.PathLike, column: str) -> list[str] | None:
+    """The stripped cells of a CSV column; None for another format or a file without that column."""
+    got = _csv_rows(path)
+    if got is None or column not in got[0]:
+        return None
+    j = got[0].index(column)
+    return [r[j].strip() if j < len(r) else "" for r in got[1]]
 
 
 def numeric_share(path: str | os.PathLike, column: str) -> float:
@@ -215,10 +223,14 @@ def numeric_share(path: str | os.PathLike, column: str) -> float:
 ISO_DATE = re.compile(r"\d{4}-\d{2}-\d{2}")
 
 
-def looks_like_datetimes(path: str | os.PathLike, column: str) -> bool:
-    """Whether a CSV column's first cell is an ISO 8601 date or date-time (read from the file's head)."""
-    cells = _csv_cells(path, column, first=True)
-    return bool(cells) and bool(ISO_DATE.match(cells[0]))
+def datetime_columns(path: str | os.PathLike) -> set[str]:
+    """The CSV columns whose first cell is an ISO 8601 date or date-time (the file's head read once;
+    empty for another format)."""
+    got = _csv_rows(path, first=True)
+    if got is None or not got[1]:
+        return set()
+    header, (row,) = got
+    return {h for j, h in enumerate(header) if h and j < len(row) and ISO_DATE.match(row[j].strip())}
 
 
 def csv_datetime_seconds(path: str | os.PathLike, column: str) -> np.ndarray | None:
@@ -226,9 +238,7 @@ def csv_datetime_seconds(path: str | os.PathLike, column: str) -> np.ndarray | N
     a decimal comma, or plain dates) in seconds from its first stamp; None when the file is no CSV,
     has no such column, or a cell is empty or not such a date-time (a logger's wall-clock stamps as
     the time axis: read as text they were dropped, and the data compared at the model's rate without
-    a word)."""
-    if not looks_like_datetimes(path, column):  # (the whole file is read only for a column of dates)
-        return None
+    a word). The whole file is read: ask it of the :func:`datetime_columns` only."""
     cells = _csv_cells(path, column)
     if not cells or not all(cells):
         return None
