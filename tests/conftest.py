@@ -9,12 +9,11 @@ settings.register_profile("explore", derandomize=False, print_blob=True)
 settings.load_profile("default")
 
 
-
 def _drop_stale_numba_caches() -> None:
     """Empty numba's on-disk caches of the package when any of its sources changed.
 
     numba checks only the file of a cached function: a constant or a compiled helper it calls from
-    another module (valve.py's MAKEUP_SMOOTHING_PA, used by dynamics.py's kernels; the parameter
+    another module (valve.py's MAKEUP_ONSET_PA and makeup_shape, used by dynamics.py's kernels; the parameter
     indices of parameters.py) can change and the cached kernel still runs the old one (a session
     saw an edit do nothing until the cache was deleted). A clean clone, as CI's, has no cache; this
     is for a working copy. Every source file is hashed: which ones a kernel depends on is not said."""

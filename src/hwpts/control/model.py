@@ -33,7 +33,7 @@ SIGNAL_UNITS = ("V", "r/min", "r/min")
 """The units the controllers read the model's valve input, pump input and output in."""
 
 
-def _check_units(document: dict, inputs, output) -> None:
+def _check_units(inputs, output) -> None:
     """Refuse a model whose valve input, pump input or output is in another unit than the controllers
     command and measure (V, r/min, r/min) by its name's suffix (``pump_pressure_pa`` matched "pump"
     and was read as a speed in r/min). A unit given as free text (``identify --unit pump=rpm``) is
@@ -95,7 +95,7 @@ class ModelBank:
             # a model of motor B's speed (or a pressure) designed controllers that steered motor A
             raise DataError(f"the model's output must be the main motor's (motor A's) speed, which the controllers "
                             f"hold; the model's output is {self.output_name!r}")
-        _check_units(document, names, self.output_name)
+        _check_units(names, self.output_name)
         self.sample_time = float(sample_time)
         self.na = int(st["na"])
         nb, nk = st["nb"], st["nk"]
