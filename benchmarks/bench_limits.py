@@ -133,8 +133,7 @@ def silverbox_extrapolation():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         plain = PWARX(random_state=0).set_params(**{**search.best_params_, "polish": False}).fit(u, y)
-    for record in ("arrow", "multisine"):
-        ru, ry = _load(cfg["tests"][record], cfg["u"], cfg["y"])
+    for record, (ru, ry) in (("arrow", (tu, ty)), ("multisine", _load(cfg["tests"]["multisine"], cfg["u"], cfg["y"]))):
         records[record] = []
         for model in (plain, search.best_estimator_):
             yh, n0 = _free_run(model, ru, ry, cfg["n_init"])

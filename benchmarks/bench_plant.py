@@ -38,8 +38,8 @@ def _best_of(fn, repeat):
 BASELINE_TOL = 1e-8  # largest scaled residual of a baseline root solve counted as solved
 
 
-def _solved(f, sol) -> bool:
-    return bool(sol.success and np.max(np.abs(f(sol.x))) < BASELINE_TOL)
+def _solved(sol) -> bool:
+    return bool(sol.success and np.max(np.abs(sol.fun)) < BASELINE_TOL)  # (root's residual at sol.x)
 
 
 def _baseline_sweep(params, voltages, pumps, limit=None):
@@ -67,11 +67,11 @@ def _baseline_sweep(params, voltages, pumps, limit=None):
                 # a solve counts where its scaled residual is below BASELINE_TOL: root's own
                 # ``success`` said yes at a point left 0.8 from a root (hybr's progress test)
                 sol = root(f, z, method="hybr")
-                if not _solved(f, sol):  # fall back to Levenberg-Marquardt, then a fresh start
+                if not _solved(sol):  # fall back to Levenberg-Marquardt, then a fresh start
                     sol = root(f, z, method="lm")
-                if not _solved(f, sol):
+                if not _solved(sol):
                     sol = root(f, np.array([2.0, 1.0, 0.4, 1.0, 0.0]), method="lm")
-                ok = _solved(f, sol)
+                ok = _solved(sol)
                 failures += not ok
                 z = sol.x
                 speeds.append(z[3] * x_scale[3] * RPM_PER_RAD_S if ok else np.nan)
