@@ -64,6 +64,9 @@ VARIANTS = {
     "rand_na1nb3_i5": {"n": 3000, "n_modes": 3, "na": 1, "nb": 3, "instance_seed": 5},
     "rand_2m_noisy": {"n": 1000, "n_modes": 2, "sigma": 0.2, "instance_seed": 11},
     "rand_6m_shared3": {"n": 20000, "n_modes": 6, "n_distinct": 3},
+    "rand_abab": {"n": 5000, "n_modes": 4, "partition": "slabs", "n_distinct": 2},
+    "rand_abab_i2": {"n": 5000, "n_modes": 4, "partition": "slabs", "n_distinct": 2, "instance_seed": 2},
+    "rand_aba_i4": {"n": 3000, "n_modes": 3, "partition": "slabs", "n_distinct": 2, "instance_seed": 4},
 }
 
 
