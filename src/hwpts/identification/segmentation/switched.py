@@ -245,7 +245,7 @@ class SwitchedSegmenter(Segmenter):
         history = [round(share, 4)]
         screen = np.sort(rng.choice(Z.shape[0], min(Z.shape[0], int(self.screen_rows)), replace=False))
         p = Z.shape[1] + 1
-        while k < cap and share < 0.999:
+        while k < cap and share < min(0.999, 1.0 - self.min_gain):  # no split can gain more than 1 - share
             predicted = owner[part.predict(Z)]
             wrong = predicted != mode
             counts = np.bincount(regions[wrong], minlength=k)  # each region's rows put into another mode
