@@ -194,3 +194,25 @@ def test_a_column_constant_over_a_region_gets_no_weight():
             warnings.simplefilter("ignore")
             theta = fit_local_models(X, y, np.zeros(40, dtype=np.int64), 1).theta[0]
         assert theta[1] == 0.0 and abs(theta[0] - 0.9) < 0.01
+
+
+@SETTINGS
+@given(n=st.integers(1, 200), n_features=st.integers(1, 4), n_modes=st.integers(1, 4), n_neighbors=st.integers(1, 15),
+       min_rows=st.integers(1, 40), duplicates=st.booleans(), seed=st.integers(0, 2**16))
+def test_mode_pieces_cover_every_row_with_a_piece_of_its_mode(n, n_features, n_modes, n_neighbors, min_rows,
+                                                              duplicates, seed):
+    """``switched``'s start: whatever the rows and labels (a few rows, repeated rows, a mode with
+    one row, more neighbours than rows), every row is in a piece, every piece belongs to the mode
+    of its rows, and every mode that has rows has a piece."""
+    from hwpts.identification.segmentation.switched import mode_pieces
+
+    rng = np.random.default_rng(seed)
+    Z = rng.standard_normal((n, n_features))
+    if duplicates:
+        Z = np.round(Z)  # many rows at the same point
+    mode = rng.integers(0, n_modes, n)
+    owner, piece = mode_pieces(Z, mode, n_modes, n_neighbors, min_rows)
+    assert piece.shape == (n,) and piece.min() >= 0 and piece.max() < owner.size
+    np.testing.assert_array_equal(owner[piece], mode)
+    assert set(owner.tolist()) == set(mode.tolist())
+    assert np.unique(piece).size == owner.size  # no piece without rows

@@ -113,10 +113,12 @@ def mode_pieces(Z, mode, K, n_neighbors, min_rows):
     src, dst = src[same], dst[same]
     # a link holds only if the row nearest its midpoint is of the same mode: where the rows are
     # sparse, a row's nearest rows of its mode may lie across another mode's slab
-    near = nn.kneighbors((Z[src] + Z[dst]) / 2.0, n_neighbors=min(3, n), return_distance=False)
-    other = (near != src[:, None]) & (near != dst[:, None])  # the link's own ends do not count
-    mid = near[np.arange(near.shape[0]), np.argmax(other, axis=1)]
-    sight = (mode[mid] == mode[src]) | ~other.any(axis=1)
+    sight = np.ones(src.size, dtype=bool)
+    if src.size:
+        near = nn.kneighbors((Z[src] + Z[dst]) / 2.0, n_neighbors=min(3, n), return_distance=False)
+        other = (near != src[:, None]) & (near != dst[:, None])  # the link's own ends do not count
+        mid = near[np.arange(near.shape[0]), np.argmax(other, axis=1)]
+        sight = (mode[mid] == mode[src]) | ~other.any(axis=1)
     graph = coo_matrix((np.ones(int(sight.sum())), (src[sight], dst[sight])), shape=(n, n))
     _, comp = connected_components(graph, directed=False)
     sizes = np.bincount(comp)
