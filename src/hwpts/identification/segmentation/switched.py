@@ -51,6 +51,7 @@ import numpy as np
 
 from hwpts.errors import ParameterError
 from hwpts.identification.partition.learner import confident_rows, noise_variance
+from hwpts.identification.partition.polyhedra import scores_to_partition
 from hwpts.identification.segmentation.alternating import SUBSET, _fit_thetas, alternate
 from hwpts.identification.segmentation.base import SegmentationResult, Segmenter, kmeans_labels, standardize
 
@@ -59,14 +60,17 @@ SIGHT_POINTS = (0.25, 0.5, 0.75)  # where along a link of mode_pieces the neares
 EM_SETTLED = 0.002
 FULL_SHARE = 0.999  # own-mode share past which neither a split nor the merge path is tried
 # the merge path (SwitchedSegmenter._merged_regions), tried where the splits leave the own-mode
-# share under FULL_SHARE: up to OVERSEGMENT k-means parts per piece, the MERGE_PAIRS most adjacent
-# same-mode pairs tried at each merge, MERGE_EM_STEPS hard-EM steps each. A few misplaced rows
+# share under FULL_SHARE: up to OVERSEGMENT k-means parts per piece, MERGE_START_STEPS hard-EM
+# steps over them, the MERGE_PAIRS most adjacent same-mode pairs tried at each merge,
+# MERGE_EM_STEPS hard-EM steps each (the classifier's fits are the path's time: on 20,000 rows
+# of 6 cells and 3 modes, 3 steps each and 20 at the start took 1.5-3 s a fit, these 0.8-1.2 s). A few misplaced rows
 # cost much fit where the modes predict far apart: on a 2-D map with 5 Voronoi cells and 2 modes
 # the splits stopped at an own-mode share of 0.973 and a validation fit of 49.9 %, the merges
 # reached 0.993 and 80.0 %, so the path is tried up to FULL_SHARE, not only where the share is poor
 OVERSEGMENT = 3
 MERGE_PAIRS = 3
-MERGE_EM_STEPS = 3  # share of the rows whose move no longer counts: the hard EM has settled
+MERGE_START_STEPS = 5
+MERGE_EM_STEPS = 1  # share of the rows whose move no longer counts: the hard EM has settled
 
 
 def switched_regression(Z, ys, K, rng, n_restarts=5, max_iter=20):
@@ -304,7 +308,7 @@ class SwitchedSegmenter(Segmenter):
         owner = np.asarray(owner, dtype=np.int64)
         screen = np.sort(rng.choice(Z.shape[0], min(Z.shape[0], int(self.screen_rows)), replace=False))
         Zs, ms = Z[screen], mode[screen]
-        regions, part = _hard_em(Zs, labels[screen], owner, ms, owner.size, self.max_iter)
+        regions, part = _hard_em(Zs, labels[screen], owner, ms, owner.size, MERGE_START_STEPS)
         history = []
         while True:
             used = np.unique(regions)
@@ -324,11 +328,14 @@ class SwitchedSegmenter(Segmenter):
             pairs = sorted(((adjacent[a, b], a, b) for a in range(k) for b in range(a + 1, k)
                             if owner[a] == owner[b] and adjacent[a, b] > 0), reverse=True)[:MERGE_PAIRS]
             best = None
+            W, c = part.scores
             for _, a, b in pairs:
                 trial = np.where(regions == b, a, regions)
                 trial[trial > b] -= 1
                 kept = np.delete(owner, b)
-                trial, trial_part = _hard_em(Zs, trial, kept, ms, k - 1, MERGE_EM_STEPS)
+                warm = scores_to_partition(np.delete(W, b, axis=0), np.delete(c, b))  # region b's scores dropped
+                warm.scores = (np.delete(W, b, axis=0), np.delete(c, b))
+                trial, trial_part = _hard_em(Zs, trial, kept, ms, k - 1, MERGE_EM_STEPS, init=warm)
                 gain = _own_mode_share(trial_part, Z, kept, mode)
                 if best is None or gain > best[0]:
                     best = (gain, b, trial, trial_part)
