@@ -57,20 +57,21 @@ from hwpts.identification.segmentation.base import SegmentationResult, Segmenter
 
 
 SIGHT_POINTS = (0.25, 0.5, 0.75)  # where along a link of mode_pieces the nearest row must be of the link's mode
-EM_SETTLED = 0.002
+EM_SETTLED = 0.002  # share of the rows whose move no longer counts: the hard EM has settled
 FULL_SHARE = 0.999  # own-mode share past which neither a split nor the merge path is tried
 # the merge path (SwitchedSegmenter._merged_regions), tried where the splits leave the own-mode
 # share under FULL_SHARE: up to OVERSEGMENT k-means parts per piece, MERGE_START_STEPS hard-EM
 # steps over them, the MERGE_PAIRS most adjacent same-mode pairs tried at each merge,
 # MERGE_EM_STEPS hard-EM steps each (the classifier's fits are the path's time: on 20,000 rows
-# of 6 cells and 3 modes, 3 steps each and 20 at the start took 1.5-3 s a fit, these 0.8-1.2 s). A few misplaced rows
-# cost much fit where the modes predict far apart: on a 2-D map with 5 Voronoi cells and 2 modes
-# the splits stopped at an own-mode share of 0.973 and a validation fit of 49.9 %, the merges
-# reached 0.993 and 80.0 %, so the path is tried up to FULL_SHARE, not only where the share is poor
+# of 6 cells and 3 modes, 3 steps each and 20 at the start took 1.5-3 s a fit, these 0.6-1.0 s,
+# with each trial warm-started). A few misplaced rows cost much fit where the modes predict far
+# apart: on a 2-D map with 5 Voronoi cells and 2 modes the splits stopped at an own-mode share of
+# 0.973 and a validation fit of 49.9 %, the merges reached 0.993 and 80.9 %, so the path is tried
+# up to FULL_SHARE, not only where the share is poor
 OVERSEGMENT = 3
 MERGE_PAIRS = 3
 MERGE_START_STEPS = 5
-MERGE_EM_STEPS = 1  # share of the rows whose move no longer counts: the hard EM has settled
+MERGE_EM_STEPS = 1
 
 
 def switched_regression(Z, ys, K, rng, n_restarts=5, max_iter=20):
@@ -140,8 +141,8 @@ def mode_pieces(Z, mode, K, n_neighbors, min_rows):
     dst = idx.ravel()
     same = (mode[src] == mode[dst]) & (src != dst) & core[src] & core[dst]
     src, dst = src[same], dst[same]
-    # a link holds only if the row nearest its midpoint is of the same mode: where the rows are
-    # sparse, a row's nearest rows of its mode may lie across another mode's slab
+    # a link holds only if the rows nearest the SIGHT_POINTS along it are of its mode: where the
+    # rows are sparse, a row's nearest rows of its mode may lie across another mode's slab
     sight = np.ones(src.size, dtype=bool)
     for t in (SIGHT_POINTS if src.size else ()):
         near = nn.kneighbors((1.0 - t) * Z[src] + t * Z[dst], n_neighbors=min(3, n), return_distance=False)
@@ -333,7 +334,7 @@ class SwitchedSegmenter(Segmenter):
             pairs = sorted(((adjacent[a, b], a, b) for a in range(k) for b in range(a + 1, k)
                             if owner[a] == owner[b] and adjacent[a, b] > 0), reverse=True)[:MERGE_PAIRS]
             best = None
-            W, c = part.scores
+            W, c = part.scores if pairs else (None, None)
             for _, a, b in pairs:
                 trial = np.where(regions == b, a, regions)
                 trial[trial > b] -= 1
