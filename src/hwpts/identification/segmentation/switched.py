@@ -159,9 +159,9 @@ def mode_pieces(Z, mode, K, n_neighbors, min_rows):
         if own.any() and not np.any(keep & own):
             keep |= comp == comp[own][np.argmax(sizes[comp[own]])]
     piece = np.full(n, -1)
-    kept = np.unique(comp[keep])
-    piece[keep] = np.searchsorted(kept, comp[keep])
-    owner = np.array([mode[np.flatnonzero(comp == j)[0]] for j in kept], dtype=np.int64)
+    kept, piece[keep] = np.unique(comp[keep], return_inverse=True)
+    _, first_row = np.unique(comp, return_index=True)  # (components are numbered 0, 1, ...)
+    owner = mode[first_row[kept]].astype(np.int64)
     for m in range(K):  # the rows of small pieces join the nearest large piece of their mode
         stray = np.flatnonzero((mode == m) & ~keep)
         home = np.flatnonzero((mode == m) & keep)
@@ -266,11 +266,11 @@ class SwitchedSegmenter(Segmenter):
         labels, part = _hard_em(Z, start, owner2, mode, k + 1, self.max_iter, init=part)
         return labels, part, _own_mode_share(part, Z, owner2, mode)
 
-    def _regions(self, Z, mode, K, rng, pieces=None):
+    def _regions(self, Z, mode, K, rng, pieces):
         """Regions of the modes (labels of ``Z``'s rows), the classifier, each region's mode and the
-        own-mode share after each split; ``pieces`` (:func:`mode_pieces`) the start, one region
-        per piece, else one region per mode."""
-        owner, start = (np.arange(K), mode.copy()) if pieces is None else pieces
+        own-mode share after each split, started from one region per piece of ``pieces``
+        (:func:`mode_pieces`)."""
+        owner, start = pieces
         k = owner.size
         cap = max(int(self.max_regions) if self.max_regions is not None else 3 * K, k)
         regions, part = _hard_em(Z, start, owner, mode, k, self.max_iter)
@@ -317,30 +317,30 @@ class SwitchedSegmenter(Segmenter):
         regions, part = _hard_em(Zs, labels[screen], owner, ms, owner.size, MERGE_START_STEPS)
         history = []
         while True:
-            used = np.unique(regions)
+            used, renumbered = np.unique(regions, return_inverse=True)
             if used.size < owner.size:  # regions the hard EM emptied are dropped
-                remap = np.full(owner.size, -1)
-                remap[used] = np.arange(used.size)
                 owner = owner[used]
-                regions, part = _hard_em(Zs, remap[regions], owner, ms, owner.size, self.max_iter)
+                regions, part = _hard_em(Zs, renumbered, owner, ms, owner.size, self.max_iter)
             share = _own_mode_share(part, Z, owner, mode)
             history.append(round(share, 4))
             k = owner.size
+            if k < 2:
+                break
             # adjacency: rows whose two most probable regions are a and b
-            top2 = np.argsort(-part.log_proba(Zs), axis=1)[:, :2] if k > 1 else np.zeros((Zs.shape[0], 2), int)
+            top2 = np.argsort(-part.log_proba(Zs), axis=1)[:, :2]
             adjacent = np.zeros((k, k))
             np.add.at(adjacent, (top2[:, 0], top2[:, 1]), 1.0)
             adjacent += adjacent.T
             pairs = sorted(((adjacent[a, b], a, b) for a in range(k) for b in range(a + 1, k)
                             if owner[a] == owner[b] and adjacent[a, b] > 0), reverse=True)[:MERGE_PAIRS]
             best = None
-            W, c = part.scores if pairs else (None, None)
             for _, a, b in pairs:
                 trial = np.where(regions == b, a, regions)
                 trial[trial > b] -= 1
                 kept = np.delete(owner, b)
-                warm = scores_to_partition(np.delete(W, b, axis=0), np.delete(c, b))  # region b's scores dropped
-                warm.scores = (np.delete(W, b, axis=0), np.delete(c, b))
+                scores = tuple(np.delete(v, b, axis=0) for v in part.scores)  # region b's scores dropped
+                warm = scores_to_partition(*scores)
+                warm.scores = scores
                 trial, trial_part = _hard_em(Zs, trial, kept, ms, k - 1, MERGE_EM_STEPS, init=warm)
                 gain = _own_mode_share(trial_part, Z, kept, mode)
                 if best is None or gain > best[0]:
