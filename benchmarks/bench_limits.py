@@ -196,13 +196,21 @@ ACTUATOR_GRID = dict(output_order=range(1, 7), input_order=range(1, 6), input_de
                              ("alternating", 3), ("alternating", 4)), polish=(False, True))
 
 
+def _free_run_fits(cfg, model, *records):
+    """The data set's score (``cfg``, as the real-data benchmark scores it) of ``model``'s free run
+    of each ``(u, y)`` record, from the record's own first outputs."""
+    from benchmarks.bench_real import _free_run, _score
+
+    return [_score(cfg, y, *_free_run(model, u, y, 0)) for u, y in records]
+
+
 def actuator_ranking():
     """Every model of :data:`ACTUATOR_GRID` on the hydraulic actuator: ``(params, test fit %,
     held-out fit %, training free-run fit %)`` rows (nan where a fit failed or a run diverged), and
     the run's time; None when the data are absent."""
     import itertools
 
-    from benchmarks.bench_real import DATA, SETS, _free_run, _load, _score
+    from benchmarks.bench_real import DATA, SETS, _load
     from hwpts.errors import HwptsError
     from hwpts.identification import PWARX, PWARXSearch
     from hwpts.identification.selection.search import _evaluate
@@ -225,10 +233,7 @@ def actuator_ranking():
             test = train = held = float("nan")
             try:
                 model = PWARX(random_state=0, **params).fit(u, y)
-                yh, n0 = _free_run(model, ut, yt, 0)
-                test = _score(cfg, yt, yh, n0)
-                yh, n0 = _free_run(model, u, y, 0)
-                train = _score(cfg, y, yh, n0)
+                test, train = _free_run_fits(cfg, model, (ut, yt), (u, y))
                 splits = search._splits(len(y), model.structure_.max_lag)
                 row = _evaluate(PWARX(random_state=0), params, u, y, splits)
                 held = float("nan") if row["mean_fit_percent"] is None else row["mean_fit_percent"]
@@ -279,7 +284,7 @@ def pick_and_place_ranking():
     """The default search's fully scored candidates on pick_and_place, each refitted on the training
     part: ``(params, held-out fit %, training free-run fit %, test fit %)`` rows (nan where a run
     diverged) and the chosen parameters; None when the data are absent."""
-    from benchmarks.bench_real import DATA, SETS, _free_run, _load, _score
+    from benchmarks.bench_real import DATA, SETS, _load
     from hwpts.identification import PWARX, PWARXSearch
 
     cfg = SETS["pick_and_place"]
@@ -298,10 +303,8 @@ def pick_and_place_ranking():
             params = {**{k: r[k] for k in keys}, "polish": r.get("polish", False),
                       "output_powers": tuple(r.get("output_powers") or ())}
             model = PWARX(random_state=0).set_params(**params).fit(u, y)
-            yh, n0 = _free_run(model, ut, yt, 0)
-            test = _score(cfg, yt, yh, n0)
-            yh, n0 = _free_run(model, u, y, 0)
-            rows.append((params, r["mean_fit_percent"], _score(cfg, y, yh, n0), test))
+            test, train = _free_run_fits(cfg, model, (ut, yt), (u, y))
+            rows.append((params, r["mean_fit_percent"], train, test))
     return {"rows": rows, "chosen": search.best_params_}
 
 
