@@ -24,6 +24,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from hwpts.errors import DataError, ParameterError
+from hwpts.identification.partition.logistic import newton_logistic
 from hwpts.text import plain_float
 
 __all__ = ["RegionPartition", "fit_linear_partition", "hyperplane_partition", "Hyperplane"]
@@ -179,7 +180,8 @@ def fit_linear_partition(X: np.ndarray, labels: np.ndarray, n_regions: int, C: f
                          max_iter: int = 500, columns=None, init=None) -> RegionPartition:
     """Multicategory linear classifier of regressors into regions, returned as polyhedra (eq. 9).
 
-    Multinomial logistic regression (scikit-learn, Newton-Cholesky) on standardised regressors; the scores
+    Multinomial logistic regression (scikit-learn's objective, solved by Newton's method in
+    :mod:`.logistic`, scikit-learn as the fallback) on standardised regressors; the scores
     are mapped back to the raw coordinates so the polyhedra apply to ``x_k`` directly. Labels must
     be ``0 .. n_regions-1``; a label without samples gets an empty region (never chosen).
     ``columns`` (indices) restricts the classifier to some regressors (the others get zero weight).
@@ -188,8 +190,6 @@ def fit_linear_partition(X: np.ndarray, labels: np.ndarray, n_regions: int, C: f
     little, and from the previous one Newton needs a third of the iterations; the optimum is the
     same, to the solver's tolerance). Ignored when a present label had no region in it.
     """
-    from sklearn.linear_model import LogisticRegression
-
     X = np.asarray(X, dtype=float)
     labels = np.asarray(labels, dtype=np.int64)
     present = np.unique(labels)
@@ -216,19 +216,18 @@ def fit_linear_partition(X: np.ndarray, labels: np.ndarray, n_regions: int, C: f
     if present.size == 1:
         b[present[0]] = 0.0
     else:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # ConvergenceWarning on separable data is harmless here
-            try:  # Newton-Cholesky: multinomial since scikit-learn 1.6, fast for few features
-                clf = LogisticRegression(C=C, solver="newton-cholesky", max_iter=100, tol=1e-8)
-                _warm_start(clf, init, present, mean, sd)
-                clf.fit(Z, labels)
-            except ValueError:  # older scikit-learn: L-BFGS
-                clf = LogisticRegression(C=C, max_iter=max_iter, tol=1e-8).fit(Z, labels)
-        coef, icpt = clf.coef_, clf.intercept_
+        start = _start(init, present, mean, sd)
+        # Newton with the Hessian in one product (partition.logistic); scikit-learn where it stops short
+        fitted = newton_logistic(Z, np.searchsorted(present, labels), present.size, C, tol=1e-8,
+                                 max_iter=100, coef=None if start is None else start[0],
+                                 intercept=None if start is None else start[1])
+        if fitted is None:
+            fitted = _sklearn_logistic(Z, labels, C, max_iter, start)
+        coef, icpt = fitted[0], fitted[1]
         if coef.shape[0] == 1:  # binary: score 0 for the first class, w'z + b for the second
             coef = np.vstack([np.zeros_like(coef), coef])
             icpt = np.concatenate([[0.0], icpt])
-        for row, cls_label in enumerate(clf.classes_):
+        for row, cls_label in enumerate(present):
             W[cls_label] = coef[row] / sd
             b[cls_label] = icpt[row] - np.dot(coef[row], mean / sd)
     partition = scores_to_partition(W, b)
@@ -236,20 +235,38 @@ def fit_linear_partition(X: np.ndarray, labels: np.ndarray, n_regions: int, C: f
     return partition
 
 
-def _warm_start(clf, init, present, mean, sd) -> None:
-    """Start ``clf`` (on rows standardised by ``mean``, ``sd``) from the raw-coordinate scores
-    ``init = (W, b)`` of a previous classifier over the same regions, when they cover ``present``."""
+def _sklearn_logistic(Z, labels, C, max_iter, start):
+    """(coef, intercept) of scikit-learn's LogisticRegression on the standardised rows ``Z``,
+    started from ``start`` (see :func:`_start`) where given."""
+    from sklearn.linear_model import LogisticRegression
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # ConvergenceWarning on separable data is harmless here
+        try:  # Newton-Cholesky: multinomial since scikit-learn 1.6, fast for few features
+            clf = LogisticRegression(C=C, solver="newton-cholesky", max_iter=100, tol=1e-8)
+            if start is not None:
+                clf.set_params(warm_start=True)
+                clf.coef_, clf.intercept_ = start
+            clf.fit(Z, labels)
+        except ValueError:  # older scikit-learn: L-BFGS
+            clf = LogisticRegression(C=C, max_iter=max_iter, tol=1e-8).fit(Z, labels)
+    return clf.coef_, clf.intercept_
+
+
+def _start(init, present, mean, sd):
+    """The raw-coordinate scores ``init = (W, b)`` of a previous classifier over the same regions
+    as a start on rows standardised by ``mean``, ``sd`` (scikit-learn's shapes: one score for two
+    classes), or None where they do not cover ``present``."""
     if init is None:
-        return
+        return None
     W, b = (np.asarray(a, dtype=float) for a in init)
     if W.ndim != 2 or W.shape[1] != mean.size or present.max() >= W.shape[0] or np.any(b[present] < -1e5):
-        return  # another shape, or a present label that had no region: no useful start
+        return None  # another shape, or a present label that had no region: no useful start
     coef = W[present] * sd  # scores in the standardised coordinates of these rows
     icpt = b[present] + W[present] @ mean
     if present.size == 2:  # binary: one score, the second class's minus the first's
         coef, icpt = coef[1:] - coef[:1], icpt[1:] - icpt[:1]
-    clf.set_params(warm_start=True)
-    clf.coef_, clf.intercept_ = coef, icpt
+    return coef, icpt
 
 
 class Hyperplane:

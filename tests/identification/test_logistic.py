@@ -1,0 +1,95 @@
+"""The region classifier's Newton solver (partition.logistic) against scikit-learn's, its reference."""
+
+import warnings
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from sklearn.linear_model import LogisticRegression
+
+from hwpts.identification.partition import fit_linear_partition
+from hwpts.identification.partition import polyhedra
+from hwpts.identification.partition.logistic import newton_logistic
+
+
+def _sklearn_scores(Z, y, C):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        clf = LogisticRegression(C=C, solver="newton-cholesky", max_iter=200, tol=1e-10).fit(Z, y)
+    return clf
+
+
+def _centred(scores):
+    """Scores up to the constant every class shares (the multinomial intercepts' free constant)."""
+    return scores - scores.mean(axis=1, keepdims=True)
+
+
+def _problem(seed, n, p, K, overlap):
+    g = np.random.default_rng(seed)
+    centres = g.normal(0.0, 2.0, (K, p))
+    y = np.arange(n) % K
+    Z = centres[y] + overlap * g.standard_normal((n, p))
+    return (Z - Z.mean(0)) / Z.std(0), y
+
+
+@pytest.mark.parametrize("K", [2, 3, 7])
+@pytest.mark.parametrize("C", [1.0, 1e4])
+def test_newton_reaches_scikit_learns_optimum(K, C):
+    Z, y = _problem(K, 400, 3, K, 1.5)
+    coef, icpt, n_iter = newton_logistic(Z, y, K, C, tol=1e-10)
+    clf = _sklearn_scores(Z, y, C)
+    assert coef.shape == clf.coef_.shape and icpt.shape == clf.intercept_.shape
+    ours, theirs = Z @ coef.T + icpt, Z @ clf.coef_.T + clf.intercept_
+    if K > 2:
+        ours, theirs = _centred(ours), _centred(theirs)
+    assert np.max(np.abs(ours - theirs)) <= 1e-5 * np.max(np.abs(theirs))
+    assert 0 < n_iter < 100
+
+
+def test_a_warm_start_at_the_optimum_takes_no_step():
+    Z, y = _problem(1, 300, 2, 4, 1.0)
+    coef, icpt, _ = newton_logistic(Z, y, 4, 1e4, tol=1e-8)
+    again = newton_logistic(Z, y, 4, 1e4, tol=1e-8, coef=coef, intercept=icpt)
+    assert again[2] == 0
+    np.testing.assert_array_equal(again[0], coef)
+
+
+def test_the_iteration_cap_returns_the_iterate_as_scikit_learn_does():
+    Z, y = _problem(2, 300, 2, 3, 0.2)  # separable: the weights grow for many iterations
+    coef, _, n_iter = newton_logistic(Z, y, 3, 1e4, tol=1e-14, max_iter=2)
+    assert n_iter == 2 and np.all(np.isfinite(coef))
+
+
+def test_the_partition_falls_back_to_scikit_learn_where_newton_cannot_step(monkeypatch):
+    Z, y = _problem(3, 300, 2, 3, 1.0)
+    direct = fit_linear_partition(Z, y, 3)
+    monkeypatch.setattr(polyhedra, "newton_logistic", lambda *a, **k: None)
+    fallback = fit_linear_partition(Z, y, 3)
+    np.testing.assert_array_equal(direct.predict(Z), fallback.predict(Z))
+
+
+def test_absent_labels_keep_an_empty_region_with_the_newton_solver():
+    Z, y = _problem(4, 300, 2, 3, 1.0)
+    y = np.where(y == 1, 3, y)  # regions 0, 2, 3 present, 1 absent
+    part = fit_linear_partition(Z, y, 4)
+    assert set(np.unique(part.predict(Z))) <= {0, 2, 3}
+    assert np.mean(part.predict(Z) == y) > 0.8
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 10_000), K=st.integers(2, 6), p=st.integers(1, 4),
+       overlap=st.floats(0.3, 3.0))
+def test_property_newton_and_scikit_learn_classify_alike(seed, K, p, overlap):
+    Z, y = _problem(seed, 60 * K, p, K, overlap)
+    fitted = newton_logistic(Z, y, K, 1e4, tol=1e-8)
+    assert fitted is not None
+    coef, icpt, _ = fitted
+    clf = _sklearn_scores(Z, y, 1e4)
+    ours, theirs = Z @ coef.T + icpt, Z @ clf.coef_.T + clf.intercept_
+    if K == 2:
+        ours, theirs = np.column_stack([0 * ours[:, 0], ours[:, 0]]), np.column_stack([0 * theirs[:, 0], theirs[:, 0]])
+    # the same class wherever scikit-learn's top score leads by more than the solvers' tolerance
+    top2 = np.sort(theirs, axis=1)[:, -2:]
+    clear = top2[:, 1] - top2[:, 0] > 1e-3 * max(1.0, np.max(np.abs(theirs)))
+    np.testing.assert_array_equal(ours.argmax(1)[clear], theirs.argmax(1)[clear])
