@@ -127,7 +127,7 @@ def test_a_unit_given_as_free_text_is_not_compared(tmp_path, capsys):
 
     from hwpts.errors import DataError
 
-    try:  # (this toy model has no dynamics to design from: refused for that, not for its units)
+    # this toy model has no dynamics to design from: refused for that, not for its units
+    with pytest.raises(DataError, match="stable valve") as error:
         ModelBank(model_to_dict(model))
-    except DataError as error:
-        assert "is in" not in str(error) and "stable valve" in str(error)
+    assert "is in" not in str(error.value)
