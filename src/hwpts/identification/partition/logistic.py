@@ -72,7 +72,7 @@ def _gradient_hessian(X1, Y, prob, beta, lam, penalised, binary):
 def newton_logistic(Z: np.ndarray, y: np.ndarray, n_classes: int, C: float, tol: float = 1e-8,
                     max_iter: int = 100, coef=None, intercept=None):
     """Fit the penalised logistic regression above to rows ``Z`` (already standardised) and class
-    indices ``y`` in ``0 .. n_classes - 1`` (every class present).
+    indices ``y`` from 0 to ``n_classes - 1`` (every class present).
 
     ``coef``, ``intercept``: a start in scikit-learn's shapes (``(1, p)`` and ``(1,)`` for two
     classes, ``(K, p)`` and ``(K,)`` otherwise). Returns ``(coef, intercept, n_iter)`` in those
