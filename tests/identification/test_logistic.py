@@ -93,3 +93,14 @@ def test_property_newton_and_scikit_learn_classify_alike(seed, K, p, overlap):
     top2 = np.sort(theirs, axis=1)[:, -2:]
     clear = top2[:, 1] - top2[:, 0] > 1e-3 * max(1.0, np.max(np.abs(theirs)))
     np.testing.assert_array_equal(ours.argmax(1)[clear], theirs.argmax(1)[clear])
+
+
+def test_the_hessian_built_in_row_chunks_gives_the_same_fit(monkeypatch):
+    from hwpts.identification.partition import logistic
+
+    Z, y = _problem(5, 500, 3, 4, 1.0)
+    whole = newton_logistic(Z, y, 4, 1e4)
+    monkeypatch.setattr(logistic, "CHUNK_ROWS", 64)  # 8 chunks, the last one short
+    chunked = newton_logistic(Z, y, 4, 1e4)
+    assert whole[2] == chunked[2]
+    np.testing.assert_allclose(chunked[0], whole[0], rtol=1e-9, atol=1e-9)

@@ -28,6 +28,7 @@ from scipy.linalg import LinAlgError, cho_factor, cho_solve
 
 ARMIJO = 1e-4  # sufficient decrease of the backtracking line search
 BACKTRACKS = 30  # step halvings before the line search gives up
+CHUNK_ROWS = 32768  # rows of the Hessian's products at a time
 
 
 def _objective(beta, X1, Y, lam, penalised, binary):
@@ -58,10 +59,17 @@ def _gradient_hessian(X1, Y, prob, beta, lam, penalised, binary):
     K = prob.shape[1]
     g = ((prob - Y).T @ X1) / n
     g[:, penalised] += lam * beta[:, penalised]
-    # H[(k, a), (l, b)] = mean_i (delta_kl p_ik - p_ik p_il) x_ia x_ib + lam delta_kl delta_ab [a penalised]
-    A = (prob[:, :, None] * X1[:, None, :]).reshape(n, K * q)
-    H = -(A.T @ A) / n
-    blocks = (A.T @ X1) / n  # row block k: mean_i p_ik x_i x_i'
+    # H[(k, a), (l, b)] = mean_i (delta_kl p_ik - p_ik p_il) x_ia x_ib + lam delta_kl delta_ab [a penalised],
+    # with A[i, (k, a)] = p_ik x_ia built CHUNK_ROWS rows at a time (its memory bounded on large data)
+    H = np.zeros((K * q, K * q))
+    blocks = np.zeros((K * q, q))  # row block k: sum_i p_ik x_i x_i'
+    for lo in range(0, n, CHUNK_ROWS):
+        P, X = prob[lo:lo + CHUNK_ROWS], X1[lo:lo + CHUNK_ROWS]
+        A = (P[:, :, None] * X[:, None, :]).reshape(X.shape[0], K * q)
+        H -= A.T @ A
+        blocks += A.T @ X
+    H /= n
+    blocks /= n
     for k in range(K):
         H[k * q:(k + 1) * q, k * q:(k + 1) * q] += blocks[k * q:(k + 1) * q]
     diag = np.tile(np.where(penalised, lam, 0.0), K)
