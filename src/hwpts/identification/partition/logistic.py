@@ -32,7 +32,8 @@ CHUNK_ROWS = 32768  # rows of the Hessian's products at a time
 
 
 def _objective(beta, X1, Y, lam, penalised, binary):
-    """(loss, probabilities) at the coefficients ``beta`` ((q,) binary, (K, q) multinomial)."""
+    """(loss, probabilities) at the coefficients ``beta`` ((q,) binary, (K, q) multinomial); ``Y``
+    the targets: 0/1 (binary) or each row's class index."""
     if binary:
         eta = X1 @ beta
         # log(1 + e^eta) - y eta, stable for either sign of eta
@@ -44,7 +45,7 @@ def _objective(beta, X1, Y, lam, penalised, binary):
     expd = np.exp(eta - top)
     total = expd.sum(axis=1, keepdims=True)
     lse = np.log(total)[:, 0] + top[:, 0]
-    loss = np.mean(lse - np.sum(eta * Y, axis=1))
+    loss = np.mean(lse - eta[np.arange(eta.shape[0]), Y])
     return loss + 0.5 * lam * float(np.sum(beta[:, penalised] ** 2)), expd / total
 
 
@@ -57,7 +58,9 @@ def _gradient_hessian(X1, Y, prob, beta, lam, penalised, binary):
         H[penalised, penalised] += lam
         return g, H
     K = prob.shape[1]
-    g = ((prob - Y).T @ X1) / n
+    residual = prob.copy()
+    residual[np.arange(n), Y] -= 1.0  # probabilities minus the one-hot targets
+    g = (residual.T @ X1) / n
     g[:, penalised] += lam * beta[:, penalised]
     # H[(k, a), (l, b)] = mean_i (delta_kl p_ik - p_ik p_il) x_ia x_ib + lam delta_kl delta_ab [a penalised],
     # with A[i, (k, a)] = p_ik x_ia built CHUNK_ROWS rows at a time (its memory bounded on large data)
@@ -84,7 +87,8 @@ def newton_logistic(Z: np.ndarray, y: np.ndarray, n_classes: int, C: float, tol:
 
     ``coef``, ``intercept``: a start in scikit-learn's shapes (``(1, p)`` and ``(1,)`` for two
     classes, ``(K, p)`` and ``(K,)`` otherwise). Returns ``(coef, intercept, n_iter)`` in those
-    shapes (at ``max |gradient| <= tol``, or the iterate after ``max_iter`` steps, as scikit-learn),
+    shapes (where ``max |gradient| <= tol`` and half the squared Newton decrement ``<= tol``, or
+    the iterate after ``max_iter`` steps, as scikit-learn),
     or None where a Newton step cannot be taken (the Hessian not positive definite to Cholesky, no
     descent direction or no decrease along it): the caller falls back to scikit-learn.
     """
@@ -102,8 +106,7 @@ def newton_logistic(Z: np.ndarray, y: np.ndarray, n_classes: int, C: float, tol:
         if coef is not None:
             beta[:p], beta[p] = np.asarray(coef, float).reshape(-1), float(np.asarray(intercept).reshape(-1)[0])
     else:
-        Y = np.zeros((n, K))
-        Y[np.arange(n), y] = 1.0
+        Y = np.asarray(y, dtype=np.int64)
         beta = np.zeros((K, q))
         if coef is not None:
             beta[:, :p], beta[:, p] = np.asarray(coef, float), np.asarray(intercept, float)
@@ -113,13 +116,16 @@ def newton_logistic(Z: np.ndarray, y: np.ndarray, n_classes: int, C: float, tol:
     f, prob = _objective(beta, X1, Y, lam, penalised, binary)
     for it in range(1, int(max_iter) + 1):
         g, H = _gradient_hessian(X1, Y, prob, beta, lam, penalised, binary)
-        if np.max(np.abs(g[free])) <= tol:
-            return _shaped(beta, p, binary) + (it - 1,)
         try:
             step = -cho_solve(cho_factor(H[np.ix_(free, free)], check_finite=False), g[free], check_finite=False)
         except (LinAlgError, ValueError):
             return None
         slope = float(g[free] @ step)
+        # scikit-learn's two criteria: max |gradient| <= tol and half the squared Newton
+        # decrement (-slope = step' H step) <= tol; the second matters where C is large (the
+        # Hessian nearly singular), the first alone stopped an iteration early at C = 1e8
+        if np.max(np.abs(g[free])) <= tol and -0.5 * slope <= tol:
+            return _shaped(beta, p, binary) + (it - 1,)
         if not np.isfinite(slope) or slope >= 0.0:
             return None
         full = np.zeros(beta.size)
