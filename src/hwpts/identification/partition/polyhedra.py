@@ -218,10 +218,10 @@ def fit_linear_partition(X: np.ndarray, labels: np.ndarray, n_regions: int, C: f
         b[present[0]] = 0.0
     else:
         start = _start(init, present, mean, sd)
-        # Newton with the Hessian in one product (partition.logistic); scikit-learn where it stops short
+        # Newton with the Hessian in one product (partition.logistic); scikit-learn where it cannot step
+        coef0, icpt0 = (None, None) if start is None else start
         fitted = newton_logistic(Z, np.searchsorted(present, labels), present.size, C, tol=1e-8,
-                                 max_iter=100, coef=None if start is None else start[0],
-                                 intercept=None if start is None else start[1])
+                                 max_iter=100, coef=coef0, intercept=icpt0)
         if fitted is None:
             fitted = _sklearn_logistic(Z, labels, C, max_iter, start)
         coef, icpt = fitted[0], fitted[1]

@@ -51,7 +51,6 @@ import numpy as np
 
 from hwpts.errors import ParameterError
 from hwpts.identification.partition.learner import confident_rows, noise_variance
-from hwpts.identification.partition.polyhedra import scores_to_partition
 from hwpts.identification.segmentation.alternating import SUBSET, _fit_thetas, alternate
 from hwpts.identification.segmentation.base import SegmentationResult, Segmenter, kmeans_labels, standardize
 
@@ -97,12 +96,14 @@ def switched_regression(Z, ys, K, rng, n_restarts=5, max_iter=20):
 def _hard_em(Z, regions, owner, mode, k, max_iter, init=None):
     """Region labels of the rows ``Z`` (each in a region of its own ``mode``; ``owner[r]`` is
     region ``r``'s mode) by hard EM: fit the classifier, move each row to its own mode's most
-    probable region, until nothing moves. Returns (labels, classifier)."""
+    probable region, until nothing moves; ``init`` a classifier or its scores ``(W, b)`` to start
+    from (used where it has ``k`` regions). Returns (labels, classifier)."""
     from hwpts.identification.partition import fit_linear_partition
 
-    part = init
+    start = getattr(init, "scores", init)
     for _ in range(max(1, int(max_iter))):
-        part = fit_linear_partition(Z, regions, k, init=part if part is not None and part.n_regions == k else None)
+        part = fit_linear_partition(Z, regions, k, init=start if start is not None and len(start[0]) == k else None)
+        start = part.scores
         logp = part.log_proba(Z)
         logp = np.where(owner[None, :] == mode[:, None], logp, -np.inf)
         new = np.argmax(logp, axis=1)
@@ -239,6 +240,11 @@ class SwitchedSegmenter(Segmenter):
         confident = confident_rows(R / sigma2, mode, self.confidence_margin, K, Z.shape[1] + 1)
         return mode, confident, mse
 
+    def _screen(self, n, rng):
+        """The sorted random ``screen_rows`` of ``n`` rows (all of them if fewer) on which starts
+        and merges are tried."""
+        return np.sort(rng.choice(n, min(n, int(self.screen_rows)), replace=False))
+
     def _split(self, Z, regions, owner, mode, k, j, wrong_rows, rng, screen):
         """The best two-way split of region ``j`` (see the module doc): (labels, classifier, share)."""
         rows = np.flatnonzero(regions == j)
@@ -276,7 +282,7 @@ class SwitchedSegmenter(Segmenter):
         regions, part = _hard_em(Z, start, owner, mode, k, self.max_iter)
         share = _own_mode_share(part, Z, owner, mode)
         history = [round(share, 4)]
-        screen = np.sort(rng.choice(Z.shape[0], min(Z.shape[0], int(self.screen_rows)), replace=False))
+        screen = self._screen(Z.shape[0], rng)
         p = Z.shape[1] + 1
         while k < cap and share < min(FULL_SHARE, 1.0 - self.min_gain):  # no split can gain more than 1 - share
             predicted = owner[part.predict(Z)]
@@ -312,7 +318,7 @@ class SwitchedSegmenter(Segmenter):
                 labels[rows[part_of == c]] = len(owner)
                 owner.append(owner0[j])
         owner = np.asarray(owner, dtype=np.int64)
-        screen = np.sort(rng.choice(Z.shape[0], min(Z.shape[0], int(self.screen_rows)), replace=False))
+        screen = self._screen(Z.shape[0], rng)
         Zs, ms = Z[screen], mode[screen]
         regions, part = _hard_em(Zs, labels[screen], owner, ms, owner.size, MERGE_START_STEPS)
         history = []
@@ -338,9 +344,7 @@ class SwitchedSegmenter(Segmenter):
                 trial = np.where(regions == b, a, regions)
                 trial[trial > b] -= 1
                 kept = np.delete(owner, b)
-                scores = tuple(np.delete(v, b, axis=0) for v in part.scores)  # region b's scores dropped
-                warm = scores_to_partition(*scores)
-                warm.scores = scores
+                warm = tuple(np.delete(v, b, axis=0) for v in part.scores)  # region b's scores dropped
                 trial, trial_part = _hard_em(Zs, trial, kept, ms, k - 1, MERGE_EM_STEPS, init=warm)
                 gain = _own_mode_share(trial_part, Z, kept, mode)
                 if best is None or gain > best[0]:
