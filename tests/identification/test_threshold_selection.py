@@ -80,6 +80,8 @@ def test_dynamic_programme_is_the_exhaustive_optimum(seed):
                 if all(b - a >= 3 for a, b in zip((0, *cuts), (*cuts, 40))))
     assert sse == pytest.approx(brute, rel=1e-5)  # (a 1e-10 ridge)
     assert len(thresholds) == 3 and np.all(np.diff(thresholds) > 0)
+    cuts = np.searchsorted(xs, thresholds, side="right")  # the thresholds' blocks are the optimum's
+    assert sum(block(a, b) for a, b in zip((0, *cuts), (*cuts, 40))) == pytest.approx(brute, rel=1e-5)
 
 
 def test_threshold_column_chosen_among_all_columns():
