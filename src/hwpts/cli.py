@@ -29,8 +29,37 @@ _INTERRUPTED_FRAMES: list = []  # see _run: interrupted runs' exceptions, kept u
 _SETTLED = threading.Event()  # the run has its status (outputs settled): a later signal is not raised
 
 
+_GIVEN = "_given_options"  # the namespace's record of the options given, dropped after parsing
+
+
+class _StoreOnce(argparse._StoreAction):
+    """argparse's ``store`` for an option given at most once: a second ``--out`` (or ``--na``) is
+    refused rather than silently replacing the first, as a second ``--input`` of the same column is.
+    Options meant to repeat use ``append``."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        if option_string is not None:
+            given = getattr(namespace, _GIVEN, None)
+            if given is None:
+                given = set()
+                setattr(namespace, _GIVEN, given)
+            if self.dest in given:
+                first, then = (str(v) if isinstance(v, os.PathLike) else v
+                               for v in (getattr(namespace, self.dest), values))
+                parser.error(f"{'/'.join(self.option_strings)} is given twice ({first!r}, then {then!r}); "
+                             f"give it once")
+            given.add(self.dest)
+        super().__call__(parser, namespace, values, option_string)
+
+
 class ArgumentParser(argparse.ArgumentParser):
-    """An argparse parser whose errors are one line, raised rather than printed."""
+    """An argparse parser whose errors are one line, raised rather than printed, and whose options
+    that take one value are given at most once."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.register("action", None, _StoreOnce)
+        self.register("action", "store", _StoreOnce)
 
     def error(self, message: str):  # noqa: D102 - argparse hook
         """Raise the parse error as a :class:`UsageError` (one line, exit 2) instead of printing usage."""
@@ -63,6 +92,26 @@ INPUT_ARGS = ("data", "model", "inputs")  # arguments that name files a command 
 OUTPUT_ARGS = ("out", "plot")  # arguments that name files a command writes
 
 
+def _check_stdout(args) -> None:
+    """A command whose result is what it prints (``validate``, ``residuals``, ``plant steady-state``)
+    refuses to run with standard output closed (``>&-``: Python then prints to nothing), unless it
+    writes a figure too; the commands that write files run, their result being the files."""
+    command = getattr(args, "prints_result", None)
+    if command and sys.stdout is None and getattr(args, "plot", None) is None:
+        raise UsageError(f"{command}: standard output is closed (>&-), and the result is printed there; "
+                         f"run it with standard output open" + (" or give --plot FILE.png" if hasattr(args, "plot")
+                                                                else ""))
+
+
+def _same_file(a, b) -> bool:
+    """Whether the paths ``a`` and ``b`` are one file (a hard link is another name of it: an
+    output written there replaces the name only, and the link to the input is lost)."""
+    try:
+        return os.path.samefile(a, b)
+    except (OSError, TypeError, ValueError):  # either missing (a new output), or not a path
+        return False
+
+
 def _check_outputs(args) -> None:
     """An output that is one of the command's inputs is refused (it would destroy the input)."""
     for flag in OUTPUT_ARGS:
@@ -72,8 +121,9 @@ def _check_outputs(args) -> None:
         target = os.path.realpath(out)
         for name in INPUT_ARGS:
             source = getattr(args, name, None)
-            if source is not None and os.path.realpath(source) == target:
-                raise UsageError(f"--{flag} {str(out)!r} is the {name} file {str(source)!r}: writing it would "
+            if source is not None and (os.path.realpath(source) == target or _same_file(source, out)):
+                link = "" if os.path.realpath(source) == target else "a hard link to "
+                raise UsageError(f"--{flag} {str(out)!r} is {link}the {name} file {str(source)!r}: writing it would "
                                  f"destroy the input; choose another output path")
             if source is not None and os.path.realpath(source).startswith(target.rstrip(os.sep) + os.sep):
                 # an output folder is replaced as a whole: the input inside it would be deleted
@@ -167,9 +217,11 @@ def _run(argv: Sequence[str] | None) -> int:
     try:
         given = list(sys.argv[1:] if argv is None else argv)
         args = build_parser().parse_args(_attach_negative_values(given))
+        vars(args).pop(_GIVEN, None)
         args.command_line = shlex.join(["hwpts", *given])
         before = _outputs(args)
         _check_outputs(args)
+        _check_stdout(args)
         with warnings.catch_warnings(record=True) as caught:
             # a library warning is one line after a run that succeeded (Python's two lines, with a
             # source path, came before the error line of one that failed: three lines for one error)

@@ -111,6 +111,11 @@ def workspace(tmp_path_factory):
         "bigtime.csv": "time_s,u1,u2,y\n" + "".join(f"{i * 1e6},{i % 4},{i % 3},{i % 5}\n" for i in range(40)),
         "flat_output.csv": "u1,u2,y\n" + "".join(f"{i % 4},{i % 3},2.5\n" for i in range(40)),
         "comment.csv": "# recorded on the rig\nu1,u2,y\n" + "".join(f"{i % 4},{i % 3},{i}\n" for i in range(40)),
+        "tinytime.csv": "t_s,u1,u2,y\n" + "".join(f"{i * 1e-300},{i % 4},{i % 3},{i % 5}\n" for i in range(40)),
+        # one input pulse: the fold that holds it out trains on a constant input
+        "spike.csv": "u,y\n" + "".join(f"{1.0 if i == 230 else 0.0},"
+                                        f"{(0.9 ** (i - 231) if i > 230 else 0.0) + 0.01 * np.sin(1.7 * i + 0.3 * i * i):.6f}\n"
+                                        for i in range(300)),
     }
     for name, text in files.items():
         if text is not None:
@@ -128,6 +133,7 @@ def workspace(tmp_path_factory):
     os.mkfifo(ws / "fifo.csv")  # reading one would block forever
     os.mkfifo(ws / "fifo.json")
     (ws / "link.json").symlink_to(ws / "afile")
+    os.link(ws / "data.csv", ws / "hardlink.csv")  # another name of data.csv
     foreign = ws / "foreign"
     foreign.mkdir()
     (foreign / "thesis.tex").write_text("precious")
@@ -149,6 +155,29 @@ def _snapshot(root: Path) -> dict:
 
 W = "{ws}"  # replaced by the workspace folder
 CASES = [
+    # --- found by a review (2026-11-27, second): a repeated option replaced the first silently, an
+    # option the run does not use was accepted, a hard link to the input was written over, wrong
+    # or unnamed ranges and causes in the messages
+    (["identify", f"{W}/data.csv", *FIXED, "--out", f"{W}/m.json", "--out", f"{W}/m2.json"],
+     "--out is given twice ('{ws}/m.json', then '{ws}/m2.json'); give it once"),
+    (["identify", f"{W}/data.csv", *FIT, "--na", "2", "--na", "3", "--out", f"{W}/m.json"], "--na is given twice (2, then 3)"),
+    (["validate", f"{W}/model.json", f"{W}/data.csv", "--time", "none", "--time", "time_s"], "--time is given twice"),
+    (["identify", f"{W}/data.csv", *FIT, "--na", "1", "--nb", "1", "--segmentation", "threshold", "--regions", "2",
+      "--all-partition-columns", "--out", f"{W}/m.json"],
+     "--all-partition-columns keeps every regressor column in a learned classifier's boundaries; --segmentation "
+     "threshold makes its partition without one"),
+    (["identify", f"{W}/data.csv", *FIT, "--na", "1", "--nb", "1", "--hyperplane", "1,0,0,0,0", "--all-partition-columns",
+      "--out", f"{W}/m.json"], "--segmentation hyperplane makes its partition without one"),
+    (["predict", f"{W}/model.json", f"{W}/data.csv", "--out", f"{W}/hardlink.csv"],
+     "--out '{ws}/hardlink.csv' is a hard link to the data file"),
+    (["control", "study", "--plants", "-1", "--seeds", "1", "--out", f"{W}/st"],
+     "argument --plants: expected a whole number >= 1, got '-1'"),
+    (["reproduce", "--quick", "--out", "/dev/null"], "--out '/dev/null': exists and is a device, pipe or socket"),
+    (["identify", f"{W}/tinytime.csv", *FIXED, "--out", f"{W}/m.json"],
+     "'{ws}/tinytime.csv': the time column 't_s' steps by 1e-300 s, expected a sample time of at least 1e-12 s"),
+    (["identify", f"{W}/spike.csv", "--input", "u", "--output", "y", "--na", "1", "--nb", "1", "--out", f"{W}/m.json"],
+     "input 'u' is constant (0) in the training data: it carries no information and makes the least squares "
+     "singular; drop it or use richer data (in the cross-validation's training rows for held-out block"),
     # --- found by a review (2026-11-27): a comment line above the header read as the header, region
     # 0 said as a count problem, a grid point named instead of the typed end, an empty --out read
     # as the current folder

@@ -490,6 +490,14 @@ def test_a_closed_stdout_still_writes_the_model_and_a_long_suffix_is_an_error(tm
     for args in (["predict", str(tmp_path / "m.json"), str(tmp_path / "d.csv"), "--out", "-"],
                  ["plant", "sweep", "--out", "-"]):
         assert main(args) == 2
+    # a command whose result is what it prints: refused too (validate exited 0 having shown nothing),
+    # unless it writes a figure
+    for args in (["validate", str(tmp_path / "m.json"), str(tmp_path / "d.csv")],
+                 ["residuals", str(tmp_path / "m.json"), str(tmp_path / "d.csv")],
+                 ["plant", "steady-state", "--valve-voltage", "5", "--pump-speed", "1000"]):
+        assert main(args) == 2
+    assert main(["validate", str(tmp_path / "m.json"), str(tmp_path / "d.csv"), "--plot", str(tmp_path / "v.png")]) == 0
+    assert (tmp_path / "v.png").exists()
     monkeypatch.undo()
     write_text_atomic(tmp_path / ("x." + "b" * 215), "{}")  # it looped for ever cutting the name
     assert (tmp_path / ("x." + "b" * 215)).read_text() == "{}"

@@ -112,7 +112,7 @@ def register(subparsers):
     r.add_argument("--json", action="store_true", help="print one JSON object")
     _mapping_args(r)
     _common_data_args(r)
-    r.set_defaults(handler=cmd_residuals)
+    r.set_defaults(handler=cmd_residuals, prints_result="residuals")
 
     e = subparsers.add_parser(
         "export", help="export a model's per-mode state space (python-control, MATLAB, JSON)",

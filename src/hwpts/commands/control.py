@@ -6,7 +6,7 @@ import argparse
 import math
 import sys
 
-from hwpts.commands._args import finite_float, non_negative_int
+from hwpts.commands._args import finite_float, integer, non_negative_int
 
 DEFAULT_CONTROLLERS = "pi,pi-no-inverse,scheduled,scheduled-no-inverse,mmac,mmac-no-inverse,mpc,mpc-no-inverse,reference"
 """hybrid-mpc is left out of the default (a 10-minute record takes it about 10 minutes); name it to run it."""
@@ -50,7 +50,7 @@ def _address(text):
 
 
 def _count(text):
-    value = non_negative_int(text)
+    value = integer(text)
     if value < 1:
         raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}")
     return value

@@ -93,6 +93,9 @@ def _available(path, found) -> str:
     return text
 
 
+MIN_SAMPLE_TIME = 1e-12  # seconds: the least sample time a model takes (PWARX.fit's check)
+
+
 def _load_dataset(path, input_names, output_name, time_name=None, rows=None, uniform=True):
     """``(data, dt, hint)``: the named columns of a data file as an :class:`IODataset`, the sample
     period from the time column (None when the file has none: time = row index), and the clause that
@@ -223,6 +226,10 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None, uni
         if uniform is not False:
             raise DataError(f"{error}{hint}") from None
         dt = math.nan  # jitter or gaps: a time axis all the same, to be resampled (--resample)
+    if dt is not None and dt < MIN_SAMPLE_TIME:  # (said by the model's fit, naming neither the file nor the column)
+        raise DataError(f"{str(path)!r}: the time column {tname!r} steps by {dt:.3g} s, expected a sample time of "
+                        f"at least {MIN_SAMPLE_TIME:g} s (as a model file holds it); give the time in seconds"
+                        + (hint or ", or pass --time none to use the sample index"))
     if period is not None:
         name, value = period
         if dt is None:
@@ -703,6 +710,11 @@ def cmd_identify(args) -> int:
     if fixed_partition and args.partition_column:  # (it was ignored)
         raise ParameterError(f"--partition-column restricts the boundaries a segmentation learns; --segmentation "
                              f"{segmentation} has a given partition (leave one of them out)")
+    if args.all_partition_columns and segmentation in SEGMENTATION_METHODS \
+            and not SEGMENTATION_METHODS[segmentation].learns_partition:  # (it was ignored)
+        raise ParameterError(f"--all-partition-columns keeps every regressor column in a learned classifier's "
+                             f"boundaries; --segmentation {segmentation} makes its partition without one (leave one "
+                             f"of them out)")
     if args.shared_modes == "on" and segmentation != "auto":  # (it was ignored)
         raise ParameterError(f"--shared-modes on: the search tries the switched segmentation beside its methods; "
                              f"--segmentation {segmentation} fixes the method (leave one of them out)")
@@ -1151,7 +1163,7 @@ def register(subparsers):
                    help="write a figure: measured and simulated output, residual, active region")
     _mapping_args(v)
     _common_data_args(v)
-    v.set_defaults(handler=cmd_validate)
+    v.set_defaults(handler=cmd_validate, prints_result="validate")
 
     r = subparsers.add_parser("predict", help="write a model's predictions for DATA to CSV",
                               description="Free-run (simulate) or one-step predictions of MODEL on DATA.")

@@ -36,7 +36,7 @@ def register(subparsers) -> None:
         "--branch", choices=("none", "up", "down"), default="none",
         help="none: averaged valve, no hysteresis; up/down: reached by increasing/decreasing voltage",
     )
-    p.set_defaults(handler=steady_state_command)
+    p.set_defaults(handler=steady_state_command, prints_result="plant steady-state")
 
     p = sub.add_parser(
         "sweep",

@@ -50,6 +50,14 @@ def statespace_json(doc: dict, generator: str) -> str:
     return json.dumps(out, indent=1, allow_nan=False) + "\n"
 
 
+def _mat_header_text() -> bytes:
+    """The 116 bytes of text that open a MAT-file (version 5), without a date: the same model gives
+    the same file."""
+    from hwpts import __version__
+
+    return f"MATLAB 5.0 MAT-file, written by hwpts {__version__}".encode("ascii").ljust(116, b" ")
+
+
 def _mat_dict(doc: dict) -> dict:
     """MATLAB variables: A, B, C, D as 3-D arrays (mode last), e, c, H and g as cell arrays."""
     modes = doc["modes"]
@@ -151,5 +159,9 @@ def write_export(path: str | os.PathLike, fmt: str, doc: dict, generator: str, m
         with atomic_path(path) as tmp:
             with open(tmp, "wb") as fh:
                 savemat(fh, _mat_dict(doc), do_compression=True, oned_as="column")
+                # the header's text: scipy writes the time of writing there ("Created on: ..."), so
+                # two exports of one model differed; the format leaves its 116 bytes free-form
+                fh.seek(0)
+                fh.write(_mat_header_text())
     else:
         raise DataError(f"--format {fmt!r}: expected one of {sorted(EXPORT_FORMATS)}")

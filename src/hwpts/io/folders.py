@@ -31,7 +31,8 @@ def check_replaceable(path: str | os.PathLike, schema: str, marker: str = "summa
     if not out.exists():
         return
     if not out.is_dir():
-        raise DataError(f"--out {str(out)!r}: exists and is a file, expected a folder")
+        kind = "a file" if out.is_file() else "a device, pipe or socket, not a file"
+        raise DataError(f"--out {str(out)!r}: exists and is {kind}, expected a folder")
     if not any(out.iterdir()):
         return
     try:

@@ -285,9 +285,12 @@ def _evaluate(estimator, params, u, y, splits, prune_below=-np.inf, names=None, 
     t0 = time.perf_counter()
     fits, regions, ones = [], [], []
     stop = error = None
+    where = ""  # the fold being fitted: a failure on a fold's rows is not one on the user's whole data
     try:
         model = _candidate(estimator, params)
-        for train, test in splits:
+        for number, (train, test) in enumerate(splits, start=1):
+            where = (f" (in the cross-validation's training rows for held-out block {number} of {len(splits)}, "
+                     f"samples {int(test[0])}-{int(test[-1])} held out)")
             fit, one, s = _score_split(model, u, y, train, test, names, output_name)
             fits.append(fit)
             ones.append(one)
@@ -296,9 +299,9 @@ def _evaluate(estimator, params, u, y, splits, prune_below=-np.inf, names=None, 
             if stop is not None:
                 break
     except HwptsError as exc:
-        error = str(exc)
+        error = f"{exc}{where}"
     except np.linalg.LinAlgError as exc:
-        error = f"singular least squares ({exc})"
+        error = f"singular least squares ({exc}){where}"
     row = _row(params, fits, ones, regions, stop, error, time.perf_counter() - t0)
     if keep_blocks:
         row["_blocks"] = (fits, ones, regions)
