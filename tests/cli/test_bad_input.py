@@ -168,6 +168,8 @@ CASES = [
      "threshold makes its partition without one"),
     (["identify", f"{W}/data.csv", *FIT, "--na", "1", "--nb", "1", "--hyperplane", "1,0,0,0,0", "--all-partition-columns",
       "--out", f"{W}/m.json"], "--segmentation hyperplane makes its partition without one"),
+    (["identify", f"{W}/data.csv", *FIT, "--na", "1", "--nb", "1", "--segmentation", "average", "--all-partition-columns",
+      "--out", f"{W}/m.json"], "--segmentation average makes its partition without one"),
     (["predict", f"{W}/model.json", f"{W}/data.csv", "--out", f"{W}/hardlink.csv"],
      "--out '{ws}/hardlink.csv' is a hard link to the data file"),
     (["control", "study", "--plants", "-1", "--seeds", "1", "--out", f"{W}/st"],
@@ -177,7 +179,10 @@ CASES = [
      "'{ws}/tinytime.csv': the time column 't_s' steps by 1e-300 s, expected a sample time of at least 1e-12 s"),
     (["identify", f"{W}/spike.csv", "--input", "u", "--output", "y", "--na", "1", "--nb", "1", "--out", f"{W}/m.json"],
      "input 'u' is constant (0) in the training data: it carries no information and makes the least squares "
-     "singular; drop it or use richer data (in the cross-validation's training rows for held-out block"),
+     "singular; drop it or use richer data (in the cross-validation's fold 4 of 5: fitted without held-out block 4, "
+     "samples 180-239)"),
+    (["predict", f"{W}/model.json", f"{W}/data.csv", "--mode", "one-step", "--mode", "simulate", "--out", f"{W}/p.csv"],
+     "--mode is given twice ('one-step', then 'simulate')"),
     # --- found by a review (2026-11-27): a comment line above the header read as the header, region
     # 0 said as a count problem, a grid point named instead of the typed end, an empty --out read
     # as the current folder

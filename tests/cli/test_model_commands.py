@@ -237,6 +237,25 @@ def test_zero_region_with_a_method_of_its_own_count(tmp_path, data_csv, capsys):
     assert [r["model"] for r in summary["regions"]] == ["affine", "zero"]
 
 
+def test_zscore_regions_are_classified_so_the_partition_column_options_apply(tmp_path, data_csv, capsys):
+    """zscore labels the rows by its rule and a classifier draws the boundary: ``--partition-column``
+    and ``--all-partition-columns`` act on it (the first was refused as for a given partition, and the
+    second would have been, by a review's first fix), while ``threshold`` draws its own."""
+    from hwpts.io.models import load_model
+
+    models = {}
+    for name, extra in (("columns", ["--partition-column", "y(k-1)"]), ("all", ["--all-partition-columns"]), ("", [])):
+        out = tmp_path / f"z{name}.json"
+        assert main(["identify", str(data_csv), *IDENTIFY, "--segmentation", "zscore", *extra, "--out", str(out)]) == 0
+        models[name] = load_model(out).partition_
+    capsys.readouterr()
+    H = models["columns"].H[0]
+    assert np.count_nonzero(H[:, 1:]) == 0 and np.count_nonzero(H[:, 0]) > 0  # y(k-1) alone
+    assert not np.allclose(models["columns"].H[0], models["all"].H[0])
+    assert main(["identify", str(data_csv), *IDENTIFY, "--segmentation", "threshold", "--regions", "2",
+                 "--all-partition-columns", "--out", str(tmp_path / "t.json")]) == 2
+
+
 def test_mat_sample_time_variable(tmp_path, capsys):
     """A .mat file's scalar Ts (as MATLAB's iddata) is its sample time when it has no time column;
     a time column that disagrees with it, or a Ts that is no period, is refused."""

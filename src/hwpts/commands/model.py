@@ -707,11 +707,12 @@ def cmd_identify(args) -> int:
     # a given partition (the user's hyperplanes, average's one region, zscore's rule): neither
     # learned nor drawn on the data, so no count to check against the rows and no method to choose
     fixed_partition = segmentation in SEGMENTATION_METHODS and SEGMENTATION_METHODS[segmentation].given_partition()
-    if fixed_partition and args.partition_column:  # (it was ignored)
+    method = SEGMENTATION_METHODS.get(segmentation)
+    if method is not None and method.returns_partition and not method.restricts_columns \
+            and args.partition_column:  # (it was ignored; zscore's labels are classified, on these columns)
         raise ParameterError(f"--partition-column restricts the boundaries a segmentation learns; --segmentation "
                              f"{segmentation} has a given partition (leave one of them out)")
-    if args.all_partition_columns and segmentation in SEGMENTATION_METHODS \
-            and not SEGMENTATION_METHODS[segmentation].learns_partition:  # (it was ignored)
+    if args.all_partition_columns and method is not None and method.returns_partition:  # (it was ignored)
         raise ParameterError(f"--all-partition-columns keeps every regressor column in a learned classifier's "
                              f"boundaries; --segmentation {segmentation} makes its partition without one (leave one "
                              f"of them out)")
@@ -1092,6 +1093,9 @@ def register(subparsers):
 
     class ModeAction(argparse.Action):
         def __call__(self, parser, namespace, values, option_string=None):
+            if getattr(namespace, "mode_given", False):  # as every option of one value (cli._StoreOnce)
+                parser.error(f"{option_string} is given twice ({getattr(namespace, self.dest)!r}, then {values!r}); "
+                             f"give it once")
             setattr(namespace, self.dest, values)
             namespace.mode_given = True
 

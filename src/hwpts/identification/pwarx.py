@@ -344,9 +344,10 @@ class PWARX(BaseEstimator):
                 raise DataError(f"{target.shape[0]} regressor rows are left after the breaks {list(breaks)}: "
                                 f"too few to fit")
         pcols = None
-        if self.partition_columns is not None and not segmenter.given_partition():
+        if self.partition_columns is not None and not (segmenter.returns_partition and not segmenter.restricts_columns):
             # (a given partition or a single model has no boundary to restrict: the model search's
-            # ARX candidates of orders without the column ranked the orders, not failed)
+            # ARX candidates of orders without the column ranked the orders, not failed; zscore's
+            # labels are classified, on these columns)
             pcols = sorted({structure.column_index(c) for c in self.partition_column_names()})
         if segmenter.uses_n_regions and isinstance(self.n_regions, (int, np.integer)) \
                 and not isinstance(self.n_regions, bool) and self.n_regions > X_reg.shape[0] // (structure.n_features + 2):

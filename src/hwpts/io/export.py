@@ -55,7 +55,7 @@ def _mat_header_text() -> bytes:
     the same file."""
     from hwpts import __version__
 
-    return f"MATLAB 5.0 MAT-file, written by hwpts {__version__}".encode("ascii").ljust(116, b" ")
+    return f"MATLAB 5.0 MAT-file, written by hwpts {__version__}".encode("ascii")[:116].ljust(116, b" ")
 
 
 def _mat_dict(doc: dict) -> dict:

@@ -11,6 +11,7 @@ class AverageSegmenter(Segmenter):
     """One region for all data (paper section V.B "average" method): plain least-squares ARX."""
 
     name = "average"
+    returns_partition = True
     uses_n_regions = False
     fixed_regions = 1
 

@@ -55,6 +55,10 @@ class Segmenter(BaseEstimator):
     #: whether the method draws its own fixed partition on regressor columns, so that
     #: ``segment`` takes ``columns=`` (the indices a PWARX's ``partition_columns`` allows)
     restricts_columns = False
+    #: whether ``segment`` returns the partition itself (its hyperplanes, its thresholds, one
+    #: region) rather than labels a classifier is then learned from (``zscore``'s are: its rule
+    #: labels the rows, the classifier draws the boundary)
+    returns_partition = False
 
     @classmethod
     def given_partition(cls) -> bool:

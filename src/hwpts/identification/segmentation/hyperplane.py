@@ -67,6 +67,7 @@ class HyperplaneSegmenter(Segmenter):
     """Partition by given hyperplanes (strings ``"a,b,c[@col1,col2]"`` or :class:`Hyperplane`)."""
 
     name = "hyperplane"
+    returns_partition = True
     uses_n_regions = False
 
     def __init__(self, *, hyperplanes=()):

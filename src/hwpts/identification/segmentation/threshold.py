@@ -347,6 +347,7 @@ class ThresholdSegmenter(Segmenter):
     """
 
     name = "threshold"
+    returns_partition = True
     uses_n_regions = True
     restricts_columns = True
 

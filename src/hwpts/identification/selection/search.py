@@ -289,8 +289,9 @@ def _evaluate(estimator, params, u, y, splits, prune_below=-np.inf, names=None, 
     try:
         model = _candidate(estimator, params)
         for number, (train, test) in enumerate(splits, start=1):
-            where = (f" (in the cross-validation's training rows for held-out block {number} of {len(splits)}, "
-                     f"samples {int(test[0])}-{int(test[-1])} held out)")
+            span = (f", samples {int(test[0])}-{int(test[-1])}" if test.size and int(test[-1]) - int(test[0]) + 1 == test.size
+                     else "")
+            where = f" (in the cross-validation's fold {number} of {len(splits)}: fitted without held-out block {number}{span})"
             fit, one, s = _score_split(model, u, y, train, test, names, output_name)
             fits.append(fit)
             ones.append(one)
