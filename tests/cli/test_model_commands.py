@@ -778,3 +778,28 @@ def test_a_mat_sample_time_that_is_no_number_is_refused(tmp_path, capsys, ts, sa
                            "--out", str(out)], "the variable 'Ts' is taken as the sample time in seconds; expected", out)
     main(["identify", str(path), "--input", "u", "--output", "y", "--na", "1", "--nb", "1", "--out", str(out)])
     assert said in capsys.readouterr().err
+
+
+def test_validate_counts_the_samples_beyond_the_training_range(tmp_path, data_csv, capsys):
+    """Data inside the training ranges: no extrapolation line and shares 0; an input driven 1.5x
+    beyond them: its share of samples outside, in the text and in --json, with the model's range."""
+    model = tmp_path / "m.json"
+    assert main(["identify", str(data_csv), *IDENTIFY, "--segmentation", "average", "--out", str(model)]) == 0
+    capsys.readouterr()
+    assert main(["validate", str(model), str(data_csv)]) == 0
+    assert "beyond the training range" not in capsys.readouterr().out
+    assert main(["validate", str(model), str(data_csv), "--json"]) == 0
+    inside = json.loads(capsys.readouterr().out)["beyond_training_range"]
+    assert set(inside) == {"y", "u1", "u2"} and all(v["share"] == 0 for v in inside.values())
+    d = make_system(5, rng=1, n=600)
+    wide = tmp_path / "wide.csv"
+    write_csv(wide, {"time_s": np.arange(600) * 0.01, "u1": 1.5 * d.inputs[:, 0], "u2": d.inputs[:, 1], "y": d.output})
+    assert main(["validate", str(model), str(wide), "--json"]) == 0
+    beyond = json.loads(capsys.readouterr().out)["beyond_training_range"]
+    lo, hi = beyond["u1"]["training_range"]
+    u1 = 1.5 * d.inputs[2:, 0]  # after the model's 2 initial conditions
+    assert beyond["u1"]["share"] == pytest.approx(np.mean((u1 < lo) | (u1 > hi)), abs=1e-6) and beyond["u1"]["share"] > 0.1
+    assert main(["validate", str(model), str(wide)]) == 0
+    line = capsys.readouterr().out.strip().splitlines()[-1]
+    assert line.startswith("beyond the training range: ") and line.endswith("the model extrapolates there")
+    assert f"'u1' {100 * beyond['u1']['share']:.2g} % (identified on {lo:.4g} to {hi:.4g})" in line

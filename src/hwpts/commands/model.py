@@ -912,7 +912,27 @@ def _validate_numbers(model, data):
     if sim.diverged:
         result["diverged_at"] = sim.diverged_at
         result["reason"] = sim.reason
+    result["beyond_training_range"] = _beyond_training(model, data)
     return result
+
+
+def _beyond_training(model, data) -> dict:
+    """Each signal's share of the samples (after the initial conditions) outside the range the model
+    was identified on, with that range: a PWA model extrapolates its outer pieces there, which a fit %
+    alone does not say (a tank model identified below its overflow level, validated above it)."""
+    m = model.structure_.max_lag
+    st = model.structure_
+    ranges = [(st.output_name, model.output_range_, data.output[m:])]
+    own = getattr(model, "input_ranges_", None)
+    if own is not None:
+        ranges += [(name, tuple(r), data.inputs[m:, j]) for j, (name, r) in enumerate(zip(st.input_names, own))]
+    out = {}
+    for name, (lo, hi), values in ranges:
+        if not (np.isfinite(lo) and np.isfinite(hi) and abs(lo) < 1e299 and abs(hi) < 1e299):
+            continue  # a model file without its ranges
+        share = float(np.mean((values < lo) | (values > hi))) if values.size else 0.0
+        out[name] = {"share": round(share, 6), "training_range": [float(lo), float(hi)]}
+    return out
 
 
 def _check_mapped_units(model, inputs, output) -> None:
@@ -984,6 +1004,10 @@ def cmd_validate(args) -> int:
     else:
         print(f"free-run fit: {result['fit_percent']:.2f} %  (rmse {result['rmse']:.6g})")
     print(f"one-step fit: {result['one_step_fit_percent']:.2f} %  (rmse {result['one_step_rmse']:.6g})")
+    beyond = [f"{name!r} {100 * v['share']:.2g} % (identified on {v['training_range'][0]:.4g} to "
+              f"{v['training_range'][1]:.4g})" for name, v in result["beyond_training_range"].items() if v["share"] > 0]
+    if beyond:
+        print(f"beyond the training range: {', '.join(beyond)} of the samples: the model extrapolates there")
     if args.plot is not None:
         print(f"wrote {args.plot}")
     return 0
