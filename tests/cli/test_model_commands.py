@@ -803,3 +803,9 @@ def test_validate_counts_the_samples_beyond_the_training_range(tmp_path, data_cs
     line = capsys.readouterr().out.strip().splitlines()[-1]
     assert line.startswith("beyond the training range: ") and line.endswith("the model extrapolates there")
     assert f"'u1' {100 * beyond['u1']['share']:.2g} % (identified on {lo:.4g} to {hi:.4g})" in line
+    # predict says it too, after the line of what it wrote (on stderr when the table goes to stdout)
+    assert main(["predict", str(model), str(wide), "--out", str(tmp_path / "p.csv")]) == 0
+    said = capsys.readouterr().out.strip().splitlines()
+    assert said[0].startswith("wrote ") and said[1] == line
+    assert main(["predict", str(model), str(data_csv), "--out", str(tmp_path / "q.csv")]) == 0
+    assert "beyond" not in capsys.readouterr().out

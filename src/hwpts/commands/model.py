@@ -916,6 +916,13 @@ def _validate_numbers(model, data):
     return result
 
 
+def _beyond_line(shares: dict) -> str:
+    """The line that says :func:`_beyond_training`'s shares, or "" where no sample lies outside."""
+    beyond = [f"{name!r} {100 * v['share']:.2g} % (identified on {v['training_range'][0]:.4g} to "
+              f"{v['training_range'][1]:.4g})" for name, v in shares.items() if v["share"] > 0]
+    return f"beyond the training range: {', '.join(beyond)} of the samples: the model extrapolates there" if beyond else ""
+
+
 def _beyond_training(model, data) -> dict:
     """Each signal's share of the samples (after the initial conditions) outside the range the model
     was identified on, with that range: a PWA model extrapolates its outer pieces there, which a fit %
@@ -1004,10 +1011,9 @@ def cmd_validate(args) -> int:
     else:
         print(f"free-run fit: {result['fit_percent']:.2f} %  (rmse {result['rmse']:.6g})")
     print(f"one-step fit: {result['one_step_fit_percent']:.2f} %  (rmse {result['one_step_rmse']:.6g})")
-    beyond = [f"{name!r} {100 * v['share']:.2g} % (identified on {v['training_range'][0]:.4g} to "
-              f"{v['training_range'][1]:.4g})" for name, v in result["beyond_training_range"].items() if v["share"] > 0]
+    beyond = _beyond_line(result["beyond_training_range"])
     if beyond:
-        print(f"beyond the training range: {', '.join(beyond)} of the samples: the model extrapolates there")
+        print(beyond)
     if args.plot is not None:
         print(f"wrote {args.plot}")
     return 0
@@ -1070,8 +1076,12 @@ def cmd_predict(args) -> int:
     columns[f"{name}_predicted"] = yhat
     columns["region"] = regions + 1  # 1-based; 0 marks the initial conditions
     write_table(args.out, columns)
+    stream = sys.stderr if is_stdout(args.out) else sys.stdout
     print(f"wrote {shown_path(args.out)} ({data.n_samples} rows, mode {mode}; region 0 = initial conditions)",
-          file=sys.stderr if is_stdout(args.out) else sys.stdout)
+          file=stream)
+    beyond = _beyond_line(_beyond_training(model, data))
+    if beyond:  # as validate says it
+        print(beyond, file=stream)
     return 0
 
 
