@@ -121,11 +121,14 @@ def _check_outputs(args) -> None:
         target = os.path.realpath(out)
         for name in INPUT_ARGS:
             source = getattr(args, name, None)
-            if source is not None and (os.path.realpath(source) == target or _same_file(source, out)):
-                link = "" if os.path.realpath(source) == target else "a hard link to "
+            if source is None:
+                continue
+            where = os.path.realpath(source)
+            if where == target or _same_file(source, out):
+                link = "" if where == target else "a hard link to "
                 raise UsageError(f"--{flag} {str(out)!r} is {link}the {name} file {str(source)!r}: writing it would "
                                  f"destroy the input; choose another output path")
-            if source is not None and os.path.realpath(source).startswith(target.rstrip(os.sep) + os.sep):
+            if where.startswith(target.rstrip(os.sep) + os.sep):
                 # an output folder is replaced as a whole: the input inside it would be deleted
                 raise UsageError(f"--{flag} {str(out)!r} holds the {name} file {str(source)!r}: the folder is "
                                  f"replaced as a whole, which would delete it; choose another output folder")

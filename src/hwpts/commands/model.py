@@ -93,9 +93,6 @@ def _available(path, found) -> str:
     return text
 
 
-MIN_SAMPLE_TIME = 1e-12  # seconds: the least sample time a model takes (PWARX.fit's check)
-
-
 def _load_dataset(path, input_names, output_name, time_name=None, rows=None, uniform=True):
     """``(data, dt, hint)``: the named columns of a data file as an :class:`IODataset`, the sample
     period from the time column (None when the file has none: time = row index), and the clause that
@@ -226,6 +223,8 @@ def _load_dataset(path, input_names, output_name, time_name=None, rows=None, uni
         if uniform is not False:
             raise DataError(f"{error}{hint}") from None
         dt = math.nan  # jitter or gaps: a time axis all the same, to be resampled (--resample)
+    from hwpts.identification.pwarx import MIN_SAMPLE_TIME
+
     if dt is not None and dt < MIN_SAMPLE_TIME:  # (said by the model's fit, naming neither the file nor the column)
         raise DataError(f"{str(path)!r}: the time column {tname!r} steps by {dt:.3g} s, expected a sample time of "
                         f"at least {MIN_SAMPLE_TIME:g} s (as a model file holds it); give the time in seconds"
@@ -708,8 +707,7 @@ def cmd_identify(args) -> int:
     # learned nor drawn on the data, so no count to check against the rows and no method to choose
     fixed_partition = segmentation in SEGMENTATION_METHODS and SEGMENTATION_METHODS[segmentation].given_partition()
     method = SEGMENTATION_METHODS.get(segmentation)
-    if method is not None and method.returns_partition and not method.restricts_columns \
-            and args.partition_column:  # (it was ignored; zscore's labels are classified, on these columns)
+    if method is not None and not method.takes_partition_columns() and args.partition_column:  # (it was ignored)
         raise ParameterError(f"--partition-column restricts the boundaries a segmentation learns; --segmentation "
                              f"{segmentation} has a given partition (leave one of them out)")
     if args.all_partition_columns and method is not None and method.returns_partition:  # (it was ignored)
@@ -927,18 +925,16 @@ def _beyond_training(model, data) -> dict:
     """Each signal's share of the samples (after the initial conditions) outside the range the model
     was identified on, with that range: a PWA model extrapolates its outer pieces there, which a fit %
     alone does not say (a tank model identified below its overflow level, validated above it)."""
-    m = model.structure_.max_lag
     st = model.structure_
-    ranges = [(st.output_name, model.output_range_, data.output[m:])]
-    own = getattr(model, "input_ranges_", None)
-    if own is not None:
-        ranges += [(name, tuple(r), data.inputs[m:, j]) for j, (name, r) in enumerate(zip(st.input_names, own))]
+    m = st.max_lag
+    ranges = [(st.output_name, model.output_range_, data.output[m:]),
+              *((name, r, data.inputs[m:, j]) for j, (name, r) in enumerate(zip(st.input_names, model.input_ranges_)))]
     out = {}
     for name, (lo, hi), values in ranges:
-        if not (np.isfinite(lo) and np.isfinite(hi) and abs(lo) < 1e299 and abs(hi) < 1e299):
-            continue  # a model file without its ranges
-        share = float(np.mean((values < lo) | (values > hi))) if values.size else 0.0
-        out[name] = {"share": round(share, 6), "training_range": [float(lo), float(hi)]}
+        if not (abs(lo) < 1e299 and abs(hi) < 1e299):
+            continue  # a model file without its ranges (nan, or the +-1e300 of PWARX.from_parts)
+        out[name] = {"share": round(float(np.mean((values < lo) | (values > hi))), 6),
+                     "training_range": [float(lo), float(hi)]}
     return out
 
 
@@ -1049,7 +1045,7 @@ def cmd_predict(args) -> int:
                         f"({', '.join(written)}); expected other signal names, got {clash[0]!r} "
                         f"(rename that column in the data and identify again)")
     if args.horizon is not None:
-        if args.mode_given:
+        if args.mode is not None:
             raise ParameterError("--horizon K is a k-step prediction: do not combine it with --mode")
         yhat = model.predict(data.inputs, data.output, horizon=args.horizon)
         regions = model.predict_regions(data.inputs, data.output) if args.horizon == 1 else None
@@ -1060,7 +1056,7 @@ def cmd_predict(args) -> int:
             _, regions = k_step_pwarx(model.structure_, model.partition_, model.theta_, data.inputs, data.output,
                                       args.horizon, center, half)
         mode = f"{args.horizon}-step"
-    elif args.mode == "simulate":
+    elif args.mode in (None, "simulate"):
         sim = model.simulate(data.inputs, data.output)
         if sim.diverged:
             raise SimulationError(f"{sim.reason}; no file written (try --mode one-step)")
@@ -1121,17 +1117,7 @@ def _png_path(text: str):
 
 def register(subparsers):
     """Add the ``identify``, ``validate`` and ``predict`` sub-commands to ``subparsers``."""
-    import argparse
-
     from hwpts.commands._args import file_with_suffix, integer, non_negative_int, positive_int
-
-    class ModeAction(argparse.Action):
-        def __call__(self, parser, namespace, values, option_string=None):
-            if getattr(namespace, "mode_given", False):  # as every option of one value (cli._StoreOnce)
-                parser.error(f"{option_string} is given twice ({getattr(namespace, self.dest)!r}, then {values!r}); "
-                             f"give it once")
-            setattr(namespace, self.dest, values)
-            namespace.mode_given = True
 
     p = subparsers.add_parser(
         "identify", help="fit a PWARX model to a data file",
@@ -1209,11 +1195,10 @@ def register(subparsers):
     r.add_argument("data", metavar="DATA")
     r.add_argument("--out", required=True, metavar="FILE.csv", type=file_with_suffix(".csv", ".parquet", stdout=True),
                    help="output table: .csv, .parquet, or - for CSV on standard output")
-    r.add_argument("--mode", choices=["simulate", "one-step"], default="simulate", action=ModeAction,
-                   help="free run (default) or one-step-ahead prediction")
+    r.add_argument("--mode", choices=["simulate", "one-step"], default=None,
+                   help="free run (simulate, the default) or one-step-ahead prediction")
     r.add_argument("--horizon", type=positive_int, default=None, metavar="K",
                    help="K-step-ahead prediction y(t|t-K): 1 is one-step, K >= the data length is the free run")
-    r.set_defaults(mode_given=False)
     _mapping_args(r)
     _common_data_args(r)
     r.set_defaults(handler=cmd_predict)

@@ -50,6 +50,7 @@ from hwpts.identification.statespace import mode_state_space
 
 __all__ = ["PWARX", "FreeRunDivergedWarning"]
 
+MIN_SAMPLE_TIME = 1e-12  # seconds: the least sample time a model (and its file) holds
 MAX_RIDGE = 1e12  # ridge 1e308 overflowed the normal equations (a LinAlgError in every candidate)
 
 DIVERGENCE_FACTOR = 50.0
@@ -344,7 +345,7 @@ class PWARX(BaseEstimator):
                 raise DataError(f"{target.shape[0]} regressor rows are left after the breaks {list(breaks)}: "
                                 f"too few to fit")
         pcols = None
-        if self.partition_columns is not None and not (segmenter.returns_partition and not segmenter.restricts_columns):
+        if self.partition_columns is not None and segmenter.takes_partition_columns():
             # (a given partition or a single model has no boundary to restrict: the model search's
             # ARX candidates of orders without the column ranked the orders, not failed; zscore's
             # labels are classified, on these columns)
@@ -761,8 +762,8 @@ def check_fit_arguments(sample_time, units, output_name) -> None:
     state changes: a bad one raised a TypeError from numpy, or after the fit had replaced the model."""
     from hwpts.identification.settings import is_number
 
-    if sample_time is not None and not (is_number(sample_time, strict=True) and sample_time >= 1e-12):
-        raise ParameterError(f"sample_time must be a number of seconds >= 1e-12 (as a model file holds it) or "
+    if sample_time is not None and not (is_number(sample_time, strict=True) and sample_time >= MIN_SAMPLE_TIME):
+        raise ParameterError(f"sample_time must be a number of seconds >= {MIN_SAMPLE_TIME:g} (as a model file holds it) or "
                              f"None, got {sample_time!r}")
     if units is not None and not isinstance(units, Mapping):
         raise ParameterError(f"units must be a dict {{signal name: unit}} or None, got {units!r}")

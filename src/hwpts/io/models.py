@@ -300,10 +300,13 @@ def _signals_section(section, structure) -> tuple[float | None, dict]:
         return None, {}
     if not isinstance(section, dict):
         raise DataError("signals must be an object")
+    from hwpts.identification.pwarx import MIN_SAMPLE_TIME
+
     dt = section.get("sample_time_s")
     if dt is not None and (isinstance(dt, bool) or not isinstance(dt, (int, float)) or not math.isfinite(dt)
-                           or dt < 1e-12):  # 1e-320 s was read, and said as "(inf Hz)"
-        raise DataError(f"signals.sample_time_s must be a number of seconds >= 1e-12, or null, got {dt!r}")
+                           or dt < MIN_SAMPLE_TIME):  # 1e-320 s was read, and said as "(inf Hz)"
+        raise DataError(f"signals.sample_time_s must be a number of seconds >= {MIN_SAMPLE_TIME:g}, or null, "
+                        f"got {dt!r}")
     units = section.get("units") or {}
     if not isinstance(units, dict) or not all(isinstance(k, str) and isinstance(v, str) for k, v in units.items()):
         raise DataError("signals.units must map signal names to unit strings")

@@ -18,6 +18,8 @@ from dataclasses import dataclass, field
 import numba
 import numpy as np
 
+from hwpts._linalg import lu_factor as _lu_factor
+from hwpts._linalg import lu_solve as _lu_solve
 from hwpts.errors import DataError, SimulationError
 from hwpts.plant.dynamics import N_STATES, jacobian_into, pump_speed_actual, rhs_into
 from hwpts.plant.parameters import PARAMETER_INDEX as _I
@@ -41,54 +43,6 @@ PROGRESS_AFTER = 600.0  # simulated seconds beyond which ``progress=True`` shows
 DEFAULT_RTOL = 1e-5
 DEFAULT_ATOL = (50.0, 50.0, 50.0, 1e-3, 1e-3, 1e-9)
 """Absolute tolerances: pressures [Pa], speeds [rad/s], spool [m]."""
-
-
-@numba.njit(cache=True)
-def _lu_factor(a, piv):
-    n = a.shape[0]
-    for k in range(n):
-        p = k
-        big = abs(a[k, k])
-        for i in range(k + 1, n):
-            if abs(a[i, k]) > big:
-                big = abs(a[i, k])
-                p = i
-        piv[k] = p
-        if big == 0.0 or not math.isfinite(big):
-            return False
-        if p != k:
-            for j in range(n):
-                tmp = a[k, j]
-                a[k, j] = a[p, j]
-                a[p, j] = tmp
-        for i in range(k + 1, n):
-            a[i, k] /= a[k, k]
-            f = a[i, k]
-            if f != 0.0:
-                for j in range(k + 1, n):
-                    a[i, j] -= f * a[k, j]
-    return True
-
-
-@numba.njit(cache=True)
-def _lu_solve(a, piv, b):
-    n = b.shape[0]
-    for k in range(n):
-        p = piv[k]
-        if p != k:
-            tmp = b[k]
-            b[k] = b[p]
-            b[p] = tmp
-    for i in range(n):
-        s = b[i]
-        for j in range(i):
-            s -= a[i, j] * b[j]
-        b[i] = s
-    for i in range(n - 1, -1, -1):
-        s = b[i]
-        for j in range(i + 1, n):
-            s -= a[i, j] * b[j]
-        b[i] = s / a[i, i]
 
 
 @numba.njit(cache=True)

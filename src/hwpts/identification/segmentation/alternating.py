@@ -48,6 +48,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from hwpts._linalg import lu_factor, lu_solve
 from hwpts.errors import ParameterError
 from hwpts.identification.segmentation.base import SegmentationResult, Segmenter, kmeans_labels, standardize
 from hwpts.identification.settings import check_count, check_number
@@ -88,6 +89,7 @@ def _alternate_kernel(Phi, ys, Z, labels, s, gamma, max_iter, ridge):  # pragma:
         _move_row(Phi, ys, Z, k, labels[k], 1.0, G, r, zsum)
         counts[labels[k]] += 1
     A = np.empty((p, p))
+    piv = np.empty(p, dtype=np.int64)
     it = 0
     for it in range(1, max_iter + 1):
         # least squares per region (ridge * max(count, 1) on the diagonal)
@@ -97,7 +99,11 @@ def _alternate_kernel(Phi, ys, Z, labels, s, gamma, max_iter, ridge):  # pragma:
                 for b in range(a + 1, p):
                     A[a, b] = G[i, a, b]
                     A[b, a] = G[i, a, b]
-            _solve_into(A, r[i], theta[i])
+            # (hwpts._linalg: np.linalg.solve here doubled the kernel's first compilation)
+            if not lu_factor(A, piv):
+                raise np.linalg.LinAlgError("Singular matrix")  # as np.linalg.solve says it
+            theta[i] = r[i]
+            lu_solve(A, piv, theta[i])
             for j in range(d):
                 cent[i, j] = zsum[i, j] / counts[i] if counts[i] else Z[0, j]
         # residuals, their mean over the assigned rows, and the cost of every row in every region
@@ -152,44 +158,6 @@ def _alternate_kernel(Phi, ys, Z, labels, s, gamma, max_iter, ridge):  # pragma:
         if same:
             break
     return labels, it
-
-
-@numba.njit(cache=True, nogil=True)
-def _solve_into(A, b, x):  # pragma: no cover - compiled
-    """``x = A^-1 b`` by Gaussian elimination with partial pivoting (LAPACK's ``gesv`` steps; ``A``
-    is overwritten). Written out because ``np.linalg.solve`` in a kernel brings numba's LAPACK
-    bindings and their error formatting into the first compilation for systems of a few unknowns:
-    without them (and without ``np.argsort`` for the re-seeding) a first ``alternate`` from an empty
-    cache took 4.9 s instead of 8.9 s, and ``hwpts reproduce --quick`` 14.2 s instead of 18.2 s,
-    with the same labels to the last digit on 245 problems."""
-    p = A.shape[0]
-    for a in range(p):
-        x[a] = b[a]
-    for c in range(p):
-        piv = c
-        big = abs(A[c, c])
-        for q in range(c + 1, p):
-            if abs(A[q, c]) > big:
-                big = abs(A[q, c])
-                piv = q
-        if piv != c:
-            for j in range(p):
-                A[c, j], A[piv, j] = A[piv, j], A[c, j]
-            x[c], x[piv] = x[piv], x[c]
-        if A[c, c] == 0.0:
-            continue
-        inv = 1.0 / A[c, c]
-        for q in range(c + 1, p):
-            f = A[q, c] * inv
-            if f != 0.0:
-                for j in range(c + 1, p):
-                    A[q, j] -= f * A[c, j]
-                x[q] -= f * x[c]
-    for c in range(p - 1, -1, -1):
-        v = x[c]
-        for j in range(c + 1, p):
-            v -= A[c, j] * x[j]
-        x[c] = v / A[c, c] if A[c, c] != 0.0 else 0.0
 
 
 @numba.njit(cache=True, nogil=True, inline="always")

@@ -61,6 +61,13 @@ class Segmenter(BaseEstimator):
     returns_partition = False
 
     @classmethod
+    def takes_partition_columns(cls) -> bool:
+        """Whether a PWARX's ``partition_columns`` shape this method's boundaries: a classifier
+        learned on its labels uses them, a threshold split chooses its column among them; a
+        partition the method returns whole (hyperplanes, one region) has none to restrict."""
+        return cls.restricts_columns or not cls.returns_partition
+
+    @classmethod
     def given_partition(cls) -> bool:
         """Whether the partition is the user's or the method's own rule (``average``, ``zscore``,
         ``hyperplane``), not one found on the data: no boundary to restrict to columns, none for

@@ -285,13 +285,10 @@ def _evaluate(estimator, params, u, y, splits, prune_below=-np.inf, names=None, 
     t0 = time.perf_counter()
     fits, regions, ones = [], [], []
     stop = error = None
-    where = ""  # the fold being fitted: a failure on a fold's rows is not one on the user's whole data
+    number = 0  # the fold being fitted: a failure on a fold's rows is not one on the user's whole data
     try:
         model = _candidate(estimator, params)
         for number, (train, test) in enumerate(splits, start=1):
-            span = (f", samples {int(test[0])}-{int(test[-1])}" if test.size and int(test[-1]) - int(test[0]) + 1 == test.size
-                     else "")
-            where = f" (in the cross-validation's fold {number} of {len(splits)}: fitted without held-out block {number}{span})"
             fit, one, s = _score_split(model, u, y, train, test, names, output_name)
             fits.append(fit)
             ones.append(one)
@@ -300,13 +297,23 @@ def _evaluate(estimator, params, u, y, splits, prune_below=-np.inf, names=None, 
             if stop is not None:
                 break
     except HwptsError as exc:
-        error = f"{exc}{where}"
+        error = f"{exc}{_fold_note(splits, number)}"
     except np.linalg.LinAlgError as exc:
-        error = f"singular least squares ({exc}){where}"
+        error = f"singular least squares ({exc}){_fold_note(splits, number)}"
     row = _row(params, fits, ones, regions, stop, error, time.perf_counter() - t0)
     if keep_blocks:
         row["_blocks"] = (fits, ones, regions)
     return row
+
+
+def _fold_note(splits, number) -> str:
+    """`` (in the cross-validation's fold j of n: ...)`` for a failure in fold ``number`` (1-based;
+    0: before any fold), with the held-out samples where they are contiguous."""
+    if number == 0:
+        return ""
+    test = splits[number - 1][1]
+    span = f", samples {int(test[0])}-{int(test[-1])}" if test.size and int(test[-1]) - int(test[0]) + 1 == test.size else ""
+    return f" (in the cross-validation's fold {number} of {len(splits)}: fitted without held-out block {number}{span})"
 
 
 def _row(params, fits, ones, regions, stop, error, elapsed) -> dict:
