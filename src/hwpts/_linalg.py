@@ -3,8 +3,8 @@ identification's alternation (neither imports the other).
 
 ``np.linalg.solve`` inside a numba kernel brings numba's LAPACK bindings and their error
 formatting into the kernel's first compilation, for systems of a few unknowns: the alternating
-segmenter's kernel took 8.9 s to compile with it, 4.9 s with these loops (``hwpts reproduce
---quick`` from an empty cache: 18.2 -> 14.7 s).
+segmenter's kernel took 8.9 s to compile with it, 4.3 s with these loops (``hwpts reproduce
+--quick`` from an empty cache: 18.2 -> 13.9 s).
 """
 
 from __future__ import annotations

@@ -101,8 +101,9 @@ def _alternate_kernel(Phi, ys, Z, labels, s, gamma, max_iter, ridge):  # pragma:
                     A[b, a] = G[i, a, b]
             # (hwpts._linalg: np.linalg.solve here doubled the kernel's first compilation)
             if not lu_factor(A, piv):
-                raise np.linalg.LinAlgError("Singular matrix")  # as np.linalg.solve says it
-            theta[i] = r[i]
+                return labels, -1  # singular: said by the caller (a raise here compiles slowly)
+            for a in range(p):  # (an element loop: a slice assignment compiles numba's shape checks)
+                theta[i, a] = r[i, a]
             lu_solve(A, piv, theta[i])
             for j in range(d):
                 cent[i, j] = zsum[i, j] / counts[i] if counts[i] else Z[0, j]
@@ -191,6 +192,8 @@ def alternate(Phi, ys, Z, labels, s, gamma=1.0, max_iter=50, ridge=1e-8):
     labels, it = _alternate_kernel(np.ascontiguousarray(Phi, dtype=float), np.ascontiguousarray(ys, dtype=float),
                                    np.ascontiguousarray(Z, dtype=float), np.asarray(labels, dtype=np.int64),
                                    int(s), float(gamma), int(max_iter), float(ridge))
+    if it < 0:
+        raise np.linalg.LinAlgError("Singular matrix")  # as np.linalg.solve says it
     return labels, _objective(Phi, ys, Z, labels, s, gamma, ridge, nf), it
 
 
