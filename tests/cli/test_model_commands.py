@@ -809,3 +809,10 @@ def test_validate_counts_the_samples_beyond_the_training_range(tmp_path, data_cs
     assert said[0].startswith("wrote ") and said[1] == line
     assert main(["predict", str(model), str(data_csv), "--out", str(tmp_path / "q.csv")]) == 0
     assert "beyond" not in capsys.readouterr().out
+    # and residuals, whose tests say as little where the model extrapolates
+    assert main(["residuals", str(model), str(wide)]) == 0
+    assert capsys.readouterr().out.strip().splitlines()[-1] == line
+    assert main(["residuals", str(model), str(wide), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["beyond_training_range"] == beyond
+    assert main(["residuals", str(model), str(data_csv)]) == 0
+    assert "beyond" not in capsys.readouterr().out

@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from hwpts.errors import DataError
-from hwpts.identification.metrics import fit_percent, parameter_error, region_accuracy, rmse
+from hwpts.identification.metrics import (fit_percent, held_out_fit, output_spread, parameter_error,
+                                          region_accuracy, rmse)
 
 
 def test_fit_percent_definition():
@@ -71,3 +72,24 @@ def test_synthetic_systems_check_their_settings():
                                   (1, {"N": 3}, "unknown setting")]:
         with pytest.raises(ParameterError, match=match):
             make_system(number, **kwargs)
+
+
+def test_held_out_fit_is_the_blocks_own_fit_or_against_the_whole_spread_where_the_output_rests():
+    """A block's score in the model search: its own fit %; where the output rests over the block
+    (its own fit % undefined) 100 (1 - RMSE / spread of the whole output), which survives a 1e160
+    scale."""
+    rng = np.random.default_rng(0)
+    y = rng.standard_normal(500)
+    yhat = y + 0.1 * rng.standard_normal(500)
+    spread = output_spread(y)
+    assert spread == pytest.approx(np.std(y))
+    assert held_out_fit(y[:50], yhat[:50], spread) == fit_percent(y[:50], yhat[:50])
+    rest = np.zeros(50)
+    assert held_out_fit(rest, rest + 0.1 * spread, spread) == pytest.approx(90.0)
+    with pytest.raises(DataError, match="constant measured output"):
+        fit_percent(rest, rest + 0.1)
+    assert held_out_fit(rest + 1e160, rest + 1e160 + 0.1 * spread * 1e160, spread * 1e160) == pytest.approx(90.0)
+    assert output_spread(y * 1e160) == pytest.approx(spread * 1e160)
+    assert np.isnan(held_out_fit(y, np.full_like(y, np.nan), spread))
+    with pytest.raises(DataError, match="an output that varies"):
+        held_out_fit(rest, rest, 0.0)

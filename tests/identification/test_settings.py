@@ -335,13 +335,21 @@ def test_a_prediction_needs_only_its_initial_conditions_and_a_static_map_no_outp
     assert static.predict_regions(u[:4]).shape == (4,)
 
 
-def test_a_constant_held_out_block_is_named_and_a_tiny_output_is_not_called_constant():
+def test_an_output_at_rest_over_a_held_out_block_is_scored_and_a_tiny_output_is_not_called_constant():
+    """A block where the output rests (a rig idle) has no fit % of its own: the search refused the
+    record ("the output is constant over held-out block 4 of 5"); each block is now scored against
+    the whole output's spread (held_out_fit)."""
     rng = np.random.default_rng(0)
-    u = rng.uniform(-1, 1, 300)[:, None]
-    y = np.zeros(300)
-    y[150] = 1.0
-    with pytest.raises(DataError, match="the output is constant over held-out block 1 of 5"):
-        PWARXSearch(PWARX(1, 1, 1, random_state=0)).fit(u, y)
+    u = rng.uniform(-1, 1, 1000)
+    u[600:800] = 0.0
+    y = np.zeros(1000)
+    for k in range(1, 1000):
+        y[k] = 0.8 * y[k - 1] + (0.5 if y[k - 1] > 0 else 1.0) * u[k - 1]
+    y[600:800] = 0.0  # idle: the fourth held-out block (samples 600-799) at rest
+    search = PWARXSearch(PWARX(1, 1, 1, random_state=0)).fit(u[:, None], y)
+    scored = [r for r in search.cv_results_ if r["mean_fit_percent"] is not None]
+    assert scored and all(np.isfinite(r["split_fits_percent"][3]) for r in scored)
+    assert search.best_estimator_.n_regions_ == 2  # the two gains of the system
     # a tiny output is scaled first (its squares are subnormal or zero): the fit of the same
     # signal at another scale, where it was "varies by 2e-200 only", and 89.995 for 89.986 % at 1e-160
     assert fit_percent([1e-200, 3e-200, 2e-200], [0.0, 0.0, 0.0]) == fit_percent([1.0, 3.0, 2.0], [0.0, 0.0, 0.0])

@@ -8,7 +8,7 @@ from hwpts.errors import DataError, ParameterError
 
 def cmd_residuals(args) -> int:
     """``hwpts residuals``: residual tests of MODEL on DATA; prints a verdict per test (or JSON), optionally a figure."""
-    from hwpts.commands.model import _model_and_data
+    from hwpts.commands.model import _beyond_line, _beyond_training, _model_and_data
     from hwpts.identification.analysis import residual_analysis
 
     model, data, _ = _model_and_data(args)
@@ -20,6 +20,8 @@ def cmd_residuals(args) -> int:
             raise DataError(f"--{error}") from None
         raise
     result = analysis.to_dict()
+    # residuals where the model extrapolates say as little about the model as a fit % does there
+    result["beyond_training_range"] = _beyond_training(model, data)
     if args.plot is not None:
         from hwpts.io.atomic import write_bytes_atomic
         from hwpts.reporting.analysis import residual_figure
@@ -53,6 +55,9 @@ def cmd_residuals(args) -> int:
                 continue
             print(f"input {name}: {100 * value:.1f} % of lags 0..{args.lags} outside the band -> "
                   f"{'uncorrelated' if value <= 0.05 else 'CORRELATED'}")
+    beyond = _beyond_line(result["beyond_training_range"])
+    if beyond:
+        print(beyond)
     if args.plot is not None:
         print(f"wrote {args.plot}")
     return 0

@@ -26,7 +26,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from hwpts.errors import ParameterError
-from hwpts.identification.metrics import fit_percent
+from hwpts.identification.metrics import held_out_fit, output_spread
 from hwpts.identification.regressors import RegressorStructure
 
 __all__ = ["neighbour_fits", "estimate_delays", "delay_candidates"]
@@ -59,7 +59,8 @@ def _predict(X, t, Xq, k):
 
 
 def neighbour_fits(u, y, orders, splits, *, n_neighbors: int = N_NEIGHBOURS, random_state=0) -> list[float]:
-    """Mean held-out one-step fit % of a nearest-neighbour predictor for each ``(na, nb, nk)`` in
+    """Mean held-out one-step fit % (:func:`~hwpts.identification.metrics.held_out_fit`) of a
+    nearest-neighbour predictor for each ``(na, nb, nk)`` in
     ``orders``, over the ``(train, test)`` sample-index pairs of ``splits``.
 
     A regressor row belongs to a part when its whole lag window does (no row mixes a training part
@@ -72,6 +73,7 @@ def neighbour_fits(u, y, orders, splits, *, n_neighbors: int = N_NEIGHBOURS, ran
     u = u[:, None] if u.ndim == 1 else u
     y = np.asarray(y, dtype=float)
     n = y.size
+    spread = output_spread(y)  # every block scored against the whole output's spread (held_out_fit)
     masks = []
     for train, test in splits:
         tr = np.zeros(n, bool)
@@ -105,8 +107,8 @@ def neighbour_fits(u, y, orders, splits, *, n_neighbors: int = N_NEIGHBOURS, ran
             mean = X[itr].mean(axis=0)
             scale = X[itr].std(axis=0)
             scale[scale <= 0] = 1.0
-            fits.append(fit_percent(t[ite], _predict((X[itr] - mean) / scale, t[itr], (X[ite] - mean) / scale,
-                                                     n_neighbors)))
+            fits.append(held_out_fit(t[ite], _predict((X[itr] - mean) / scale, t[itr], (X[ite] - mean) / scale,
+                                                      n_neighbors), spread))
         out.append(float(np.mean(fits)) if np.all(np.isfinite(fits)) else float("nan"))
     return out
 

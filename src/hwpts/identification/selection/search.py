@@ -3,7 +3,9 @@
 
 Every candidate (a set of the estimator's parameters) is fitted on the training part of each
 cross-validation split and simulated in *free run* over the held-out block, from the block's first
-measured outputs (initial conditions). Its score is the mean free-run fit % over the blocks; a
+measured outputs (initial conditions). Its score is the mean free-run fit % over the blocks (a
+block where the output rests, which has no fit % of its own, measured against the spread of the
+whole output: :func:`~hwpts.identification.metrics.held_out_fit`); a
 candidate whose free run diverges on any block, or whose fit fails, scores ``nan`` and ranks last.
 The best candidate is refitted on all the data (``best_estimator_``); a refit whose own free run
 diverges on a block, or scores (in sample) more than ``refit_margin`` points below its
@@ -87,7 +89,7 @@ import numpy as np
 from sklearn.base import BaseEstimator, clone
 
 from hwpts.errors import DataError, HwptsError, IdentificationError, ParameterError
-from hwpts.identification.metrics import fit_percent
+from hwpts.identification.metrics import held_out_fit, output_spread
 from hwpts.identification.selection.splitters import BlockedSplit, breaks_of
 from hwpts.identification.threads import single_threaded
 
@@ -217,16 +219,21 @@ def _score_split(model, u, y, train, test, names=None, output_name=None):
 
 
 def _block_fits(model, u, y, test):
-    """``(free run, one-step)`` fit % of a fitted ``model`` on the held-out block ``test``: simulated
-    from the block's first measured outputs (free run ``nan`` if it diverged); a static map (no
-    lagged signal) on any rows, where the free run is the one-step prediction."""
+    """``(free run, one-step)`` fit % of a fitted ``model`` on the held-out block ``test``
+    (:func:`~hwpts.identification.metrics.held_out_fit`, the spread of all of ``y`` where the
+    output rests over the block): simulated from the block's first
+    measured outputs (free run ``nan`` if it diverged); a static map (no lagged signal) on any rows,
+    where the free run is the one-step prediction."""
+    spread = output_spread(y)
     if model.structure_.max_lag == 0:
-        score = model.simulate(u[test], y[test]).score(y[test])
+        sim = model.simulate(u[test], y[test])
+        score = float("nan") if sim.diverged else held_out_fit(y[test], sim.output, spread)
         return score, score
     rows = slice(int(test[0]), int(test[-1]) + 1)
     m = model.structure_.max_lag
-    free = model.simulate(u[rows], y[rows]).score(y[rows])
-    return free, fit_percent(y[rows][m:], model.predict(u[rows], y[rows])[m:])
+    sim = model.simulate(u[rows], y[rows])
+    free = float("nan") if sim.diverged else held_out_fit(y[rows][m:], sim.output[m:], spread)
+    return free, held_out_fit(y[rows][m:], model.predict(u[rows], y[rows])[m:], spread)
 
 
 def _behind(free, one, lead_free, lead_one) -> bool:
@@ -711,11 +718,6 @@ class PWARXSearch(BaseEstimator):
             deepest = max(order_grid, key=lambda o: self._max_lag(base, o))  # name what asks for the lags
             raise ParameterError(f"{error} (the largest lag, {max_lag}, is that of the orders {deepest}: search "
                                  f"smaller ones)") from None
-        for number, (_, test) in enumerate(splits, start=1):
-            if test.size > max_lag and np.ptp(yy[test[max_lag:]]) == 0:
-                raise DataError(f"PWARXSearch: the output is constant over held-out block {number} of {len(splits)} "
-                                f"(samples {test[0]}-{test[-1]}): no fit % can score a model there; give the model "
-                                f"settings (orders, segmentation, regions) or data whose output moves throughout")
         self.n_splits_ = len(splits)
         bar = None
         if self.progress:
