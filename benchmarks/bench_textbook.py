@@ -104,8 +104,8 @@ def data(name, seed, n):
 
 def tank_methods(seeds) -> None:
     """``--methods``: on ``integrator_sat`` (3,000 samples, the true orders 1/1/1, 3 regions), per
-    seed, the free-run fit % of ``threshold``, ``alternating`` and ``threshold-alternating`` on the
-    noise-free validation record; the alternation's objective where ``alternating`` landed, where
+    seed, the free-run fit % of ``threshold``, ``alternating``, ``hinging`` (two hinges of a
+    continuous PWA map) and ``threshold-alternating`` on the noise-free validation record; the alternation's objective where ``alternating`` landed, where
     ``threshold-alternating`` landed (from the split), and at the true modes' labels; and the
     learned boundaries' input-to-output weight ratio (the true boundaries' is 0.2)."""
     from hwpts.identification import PWARX
@@ -113,14 +113,14 @@ def tank_methods(seeds) -> None:
 
     print("integrator_sat, 3,000 samples, na 1, nb 1, nk 1, 3 regions: free-run fit % (noise-free validation); "
           "alternation objective; boundary weight ratio |w_u / w_y|")
-    print(f"{'seed':>4s} {'threshold':>10s} {'alternating':>12s} {'thr-alt':>8s}   {'obj alt':>8s} {'obj thr-alt':>11s} "
+    print(f"{'seed':>4s} {'threshold':>10s} {'alternating':>12s} {'hinging':>8s} {'thr-alt':>8s}   {'obj alt':>8s} {'obj thr-alt':>11s} "
           f"{'obj true':>9s}   ratio")
     for seed in seeds:
         (u, y), (uv, yv) = data("integrator_sat", seed, 3000)
         fits, objective = {}, {}
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            for method in ("threshold", "alternating", "threshold-alternating"):
+            for method in ("threshold", "alternating", "hinging", "threshold-alternating"):
                 model = PWARX(1, 1, 1, n_regions=3, segmentation=method, random_state=0).fit(u, y)
                 fits[method] = free_fit(model, uv, yv)
                 objective[method] = model.segmentation_info_.get("objective", np.nan)
@@ -130,7 +130,8 @@ def tank_methods(seeds) -> None:
         Z, ys, Phi = scaled_problem(X, t)
         at_true = _objective(Phi, ys, Z, true, 3, 1.0, 1e-8, Z.shape[1])
         ratios = [abs(h[1] / h[0]) for H in model.partition_.H for h in H]
-        print(f"{seed:4d} {fits['threshold']:10.1f} {fits['alternating']:12.1f} {fits['threshold-alternating']:8.1f}   "
+        print(f"{seed:4d} {fits['threshold']:10.1f} {fits['alternating']:12.1f} {fits['hinging']:8.1f} "
+              f"{fits['threshold-alternating']:8.1f}   "
               f"{objective['alternating']:8.5f} {objective['threshold-alternating']:11.5f} {at_true:9.5f}   "
               f"{min(ratios):.2f}-{max(ratios):.2f}", flush=True)
 

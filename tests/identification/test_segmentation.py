@@ -21,7 +21,7 @@ from hwpts.identification.synthetic import make_system
 
 def test_registry_names_and_unknown_name_lists_them():
     assert set(SEGMENTATION_METHODS) == {"average", "zscore", "kmeans", "hyperplane", "clustering",
-                                         "alternating", "threshold", "threshold-alternating", "switched"}
+                                         "alternating", "threshold", "threshold-alternating", "switched", "hinging"}
     with pytest.raises(ParameterError, match=r"unknown segmentation 'nope'; valid methods are \['alternating'"):
         make_segmenter("nope")
 
@@ -553,3 +553,44 @@ def test_the_partition_learner_refuses_columns_it_has_not():
         with pytest.raises(ParameterError, match="columns must be distinct indices of X's columns 0 .. 1"):
             PartitionLearner().learn(X, X[:, 0], labels, 2, columns=columns)
     assert np.array_equal(PartitionLearner().learn(X, X[:, 0], labels, 2, columns=np.array([0]))[0], labels)
+
+
+def _tank(n, rng, noise=0.03):
+    """The textbook tank that empties and overflows, y(k) = min(10, max(0, y(k-1) + 0.2 u(k-1))):
+    a continuous PWA map whose boundaries are oblique in (y(k-1), u(k-1)); u held 30 samples."""
+    u = np.repeat(rng.uniform(-1.2, 1.2, n // 30 + 1), 30)[:n]
+    y = np.zeros(n)
+    for k in range(1, n):
+        y[k] = min(10.0, max(0.0, y[k - 1] + 0.2 * u[k - 1]))
+    return u[:, None], y + noise * y.std() * rng.standard_normal(n) * (np.arange(n) > 0)
+
+
+def test_hinging_finds_the_pieces_of_a_continuous_map_where_they_meet():
+    """Breiman's hinging hyperplanes (1993): two hinges of the tank are its two saturations, so the
+    regions' boundaries are the lines y(k-1) + 0.2 u(k-1) = 0 and = 10 where the pieces meet, and
+    the model simulates a new record; a threshold split on y(k-1) cannot leave the empty tank."""
+    u, y = _tank(3000, np.random.default_rng(0))
+    uv, yv = _tank(3000, np.random.default_rng(1), noise=0.0)
+    model = PWARX(1, 1, 1, n_regions=3, segmentation="hinging", random_state=0).fit(u, y)
+    assert model.n_regions_ == 3 and model.segmentation_info_["hinges"] == 2
+    X = np.column_stack([yv[:-1], uv[:-1, 0]])
+    raw = X[:, 0] + 0.2 * X[:, 1]
+    true = np.where(raw <= 0, 0, np.where(raw >= 10, 2, 1))
+    assert region_accuracy(true, model.predict_regions(uv, yv)[1:]) > 0.98
+    fit = model.simulate(uv, yv).score(yv)  # an integrator: its free run drifts on small offsets
+    assert fit > 80.0
+    threshold = PWARX(1, 1, 1, n_regions=3, segmentation="threshold", random_state=0).fit(u, y)
+    assert threshold.simulate(uv, yv).score(yv) < fit - 50  # (measured: 84.7 % against -88.0 %)
+
+
+def test_hinging_recovers_a_noise_free_hinge_exactly_and_checks_its_settings():
+    rng = np.random.default_rng(3)
+    X = rng.uniform(-1, 1, (400, 2))
+    t = 0.5 * X[:, 0] - X[:, 1] + 2.0 * np.maximum(0.0, X[:, 0] + X[:, 1] - 0.3)
+    seg = make_segmenter("hinging").segment(X, t, 2, None, 0)
+    side = (X[:, 0] + X[:, 1] - 0.3 > 0).astype(int)
+    assert seg.n_regions == 2 and region_accuracy(side, seg.labels) == 1.0
+    with pytest.raises(ParameterError, match="hinging: n_starts must be auto or an int >= 1, got 0"):
+        make_segmenter("hinging", n_starts=0).segment(X, t, 2, None, 0)
+    one = make_segmenter("hinging").segment(X, t, 1, None, 0)
+    assert one.n_regions == 1 and np.all(one.labels == 0)

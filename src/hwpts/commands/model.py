@@ -709,7 +709,8 @@ def cmd_identify(args) -> int:
     method = SEGMENTATION_METHODS.get(segmentation)
     if method is not None and not method.takes_partition_columns() and args.partition_column:  # (it was ignored)
         raise ParameterError(f"--partition-column restricts the boundaries a segmentation learns; --segmentation "
-                             f"{segmentation} has a given partition (leave one of them out)")
+                             f"{segmentation} {'has a given partition' if fixed_partition else 'places its boundaries itself'} "
+                             f"(leave one of them out)")
     if args.all_partition_columns and method is not None and method.returns_partition:  # (it was ignored)
         raise ParameterError(f"--all-partition-columns keeps every regressor column in a learned classifier's "
                              f"boundaries; --segmentation {segmentation} makes its partition without one (leave one "
@@ -1093,8 +1094,8 @@ def _common_data_args(parser):
 
 # the registry's names, written out so that `hwpts --help` does not import the library (a test
 # checks that they match hwpts.identification.segmentation.SEGMENTATION_METHODS)
-SEGMENTATION_NAMES = ("alternating", "average", "clustering", "hyperplane", "kmeans", "switched", "threshold",
-                      "threshold-alternating", "zscore")
+SEGMENTATION_NAMES = ("alternating", "average", "clustering", "hinging", "hyperplane", "kmeans", "switched",
+                      "threshold", "threshold-alternating", "zscore")
 
 
 def _mapping_args(parser):

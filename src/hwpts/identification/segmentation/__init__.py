@@ -11,6 +11,8 @@ The registry's keys are the names the CLI accepts (``hwpts identify --segmentati
 - ``threshold``: thresholds on one regressor column, e.g. ``y(k-1)``, by least squares (SETAR/TARX);
 - ``threshold-alternating``: that threshold split as the start of the alternation, the partition
   then learned (oblique boundaries from contiguous modes);
+- ``hinging``: ``n_regions - 1`` hinging hyperplanes of a continuous PWA map (Breiman 1993), the
+  regions their sides (boundaries where the pieces meet: saturations, dead zones);
 - ``switched``: ``n_regions`` distinct local models (switched regression), then the regions each covers
   (modes that share parameters on disjoint regions);
 
@@ -25,6 +27,7 @@ from hwpts.identification.segmentation.alternating import AlternatingSegmenter
 from hwpts.identification.segmentation.average import AverageSegmenter
 from hwpts.identification.segmentation.base import SegmentationResult, Segmenter, clear_caches
 from hwpts.identification.segmentation.clustering import ClusteringSegmenter
+from hwpts.identification.segmentation.hinging import HingingSegmenter
 from hwpts.identification.segmentation.hyperplane import HyperplaneSegmenter
 from hwpts.identification.segmentation.kmeans import KMeansSegmenter
 from hwpts.identification.segmentation.switched import SwitchedSegmenter
@@ -42,10 +45,11 @@ SEGMENTATION_METHODS: dict[str, type[Segmenter]] = {
     "threshold": ThresholdSegmenter,
     "threshold-alternating": ThresholdAlternatingSegmenter,
     "switched": SwitchedSegmenter,
+    "hinging": HingingSegmenter,
 }
 
 __all__ = ["SEGMENTATION_METHODS", "make_segmenter", "Segmenter", "SegmentationResult", "clear_caches",
-           "AlternatingSegmenter", "AverageSegmenter", "ClusteringSegmenter", "HyperplaneSegmenter",
+           "AlternatingSegmenter", "AverageSegmenter", "ClusteringSegmenter", "HingingSegmenter", "HyperplaneSegmenter",
            "KMeansSegmenter", "SwitchedSegmenter", "ThresholdAlternatingSegmenter", "ThresholdSegmenter",
            "ZScoreSegmenter"]
 
