@@ -27,8 +27,9 @@ search with 11 regions (test RMSE 3.33 / 0.90 mV against the output powers' 0.41
 split's free run is worse than none (as ``threshold-alternating``), the held-out blocks chose it with
 7-10 regions on the tank and the search's median over 5 seeds fell from 94.0 % to 81.3 %.
 
-``n_regions`` asks for ``n_regions - 1`` hinges (two parallel hinges make the three pieces of a
-saturation on both sides). The hinges are fitted by variable projection (Golub & Pereyra 1973):
+``n_regions`` asks for ``n_regions - 1`` hinges: two parallel hinges make the three pieces of a
+saturation on both sides, two that cross inside the data four (up to ``2 ** (n_regions - 1)``
+regions; the fitted model's ``n_regions_`` says how many). The hinges are fitted by variable projection (Golub & Pereyra 1973):
 given the hinges ``(w_j, b_j)`` the affine part and the ``beta_j`` are a least-squares solve, so
 Levenberg-Marquardt (scipy's ``least_squares``, ``method="lm"``) moves the hinges only, on the
 residual of that solve, with Kaufman's (1975) Jacobian. The starts are ``n_starts`` random
