@@ -91,5 +91,11 @@ def test_held_out_fit_is_the_blocks_own_fit_or_against_the_whole_spread_where_th
     assert held_out_fit(rest + 1e160, rest + 1e160 + 0.1 * spread * 1e160, spread * 1e160) == pytest.approx(90.0)
     assert output_spread(y * 1e160) == pytest.approx(spread * 1e160)
     assert np.isnan(held_out_fit(y, np.full_like(y, np.nan), spread))
+    # at rest to rounding (a spread 1e-9 of the record's or less) as at rest: it scored -1e10 %
+    nearly = rest.copy()
+    nearly[5] = 1e-9 * spread
+    assert held_out_fit(nearly, nearly + 0.1 * spread, spread) == pytest.approx(90.0)
+    with pytest.raises(DataError, match="empty"):
+        held_out_fit([], [], spread)
     with pytest.raises(DataError, match="an output that varies"):
         held_out_fit(rest, rest, 0.0)

@@ -594,3 +594,25 @@ def test_hinging_recovers_a_noise_free_hinge_exactly_and_checks_its_settings():
         make_segmenter("hinging", n_starts=0).segment(X, t, 2, None, 0)
     one = make_segmenter("hinging").segment(X, t, 1, None, 0)
     assert one.n_regions == 1 and np.all(one.labels == 0)
+    # the hinge's directions on the allowed columns only (a PWARX's partition_columns)
+    cut = make_segmenter("hinging").segment(X, t, 2, None, 0, columns=[1])
+    assert cut.n_regions == 2 and np.all(cut.partition.H[0][:, 0] == 0)
+
+
+def test_hinging_gives_the_same_model_for_the_same_seed_and_ignores_a_column_constant_to_rounding():
+    """A review found 2-3 different models in 6 fits of one seed (a hinge's scale is free, and
+    scipy's Levenberg-Marquardt on that rank-deficient Jacobian did not repeat itself), and an input
+    constant to rounding (spread 1e-17) given a boundary weight of 4e18."""
+    u, y = _tank(1000, np.random.default_rng(0))
+    fits = [PWARX(1, 1, 1, n_regions=3, segmentation="hinging", random_state=0).fit(u, y) for _ in range(4)]
+    for other in fits[1:]:
+        np.testing.assert_array_equal(other.theta_, fits[0].theta_)
+        np.testing.assert_array_equal(other.training_labels_, fits[0].training_labels_)
+    rng = np.random.default_rng(1)
+    u2 = np.column_stack([u[:, 0], np.full(1000, 0.1)])
+    u2[-1, 1] = 0.2  # (no regressor row holds u2's last sample: its column u2(k-1) is 0.1 throughout)
+    model = PWARX(1, 1, 1, n_regions=3, segmentation="hinging", random_state=0).fit(u2, y)
+    assert all(np.all(np.abs(h[:, 2]) == 0) for h in model.partition_.H)
+    moved = u2.copy()
+    moved[:, 1] += 1e-12 * rng.standard_normal(1000)
+    np.testing.assert_array_equal(model.predict_regions(moved, y), model.predict_regions(u2, y))

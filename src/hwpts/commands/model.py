@@ -709,8 +709,7 @@ def cmd_identify(args) -> int:
     method = SEGMENTATION_METHODS.get(segmentation)
     if method is not None and not method.takes_partition_columns() and args.partition_column:  # (it was ignored)
         raise ParameterError(f"--partition-column restricts the boundaries a segmentation learns; --segmentation "
-                             f"{segmentation} {'has a given partition' if fixed_partition else 'places its boundaries itself'} "
-                             f"(leave one of them out)")
+                             f"{segmentation} has a given partition (leave one of them out)")
     if args.all_partition_columns and method is not None and method.returns_partition:  # (it was ignored)
         raise ParameterError(f"--all-partition-columns keeps every regressor column in a learned classifier's "
                              f"boundaries; --segmentation {segmentation} makes its partition without one (leave one "

@@ -72,10 +72,14 @@ def fit_percent(y, yhat) -> float:
     return float(100.0 * (1.0 - np.linalg.norm(y - yhat) / den))
 
 
+REST = 1e-9  # a held-out block whose output's spread is at most this share of the record's rests
+
+
 def held_out_fit(measured, predicted, spread) -> float:
     """Fit % of ``predicted`` on a held-out block of the model search: the block's own fit %
     (:func:`fit_percent`), or, where the output rests over the block (a tank empty, a rig idle: its
-    own fit % is undefined), ``100 (1 - RMSE / spread)`` against the ``spread`` (standard deviation)
+    own fit % is undefined, or a rounding error's where its spread is at most :data:`REST` of the
+    record's), ``100 (1 - RMSE / spread)`` against the ``spread`` (standard deviation)
     of the whole output searched; ``nan`` where ``predicted`` is not finite (a diverged run).
 
     The search refused a record with such a block ("the output is constant over held-out block 4
@@ -88,14 +92,14 @@ def held_out_fit(measured, predicted, spread) -> float:
     >>> round(held_out_fit([0.0, 0.0], [0.0, 0.5], spread=1.0), 3)
     64.645
     """
-    y = np.asarray(measured, dtype=float)
-    yhat = np.asarray(predicted, dtype=float)
+    y, yhat = _pair(measured, predicted)
     if not np.all(np.isfinite(yhat)):
         return float("nan")
-    if np.ptp(y) > 0:
-        return fit_percent(y, yhat)
     if not spread > 0:
         raise DataError(f"a held-out fit needs the spread of an output that varies, got {spread!r}")
+    scale = max(float(np.max(np.abs(y))), float(spread))
+    if np.std(y / scale) > REST * spread / scale:
+        return fit_percent(y, yhat)
     # scaled first: the squares of a 1e160 signal overflow (fit_percent does the same)
     scale = max(float(np.max(np.abs(y))), float(np.max(np.abs(yhat))), float(spread))
     rmse = float(np.sqrt(np.mean(((y - yhat) / scale) ** 2)))

@@ -52,7 +52,8 @@ class RegionPartition:
         self.n_features = n.pop() if n else None
         if self.n_features is None:
             self.n_features = Hs[0].shape[1] if Hs[0].ndim == 2 else 0
-        self.H = [h.reshape(-1, self.n_features) for h in Hs]
+        # (no features: a block of no rows, which reshape(-1, 0) cannot size)
+        self.H = [h.reshape(-1, self.n_features) if self.n_features else h.reshape(h.shape[0], 0) for h in Hs]
         self.g = [np.asarray(gi, dtype=float).reshape(-1) for gi in g]
         for i, (h, gi) in enumerate(zip(self.H, self.g)):
             if h.shape[0] != gi.shape[0]:
