@@ -816,3 +816,32 @@ def test_validate_counts_the_samples_beyond_the_training_range(tmp_path, data_cs
     assert json.loads(capsys.readouterr().out)["beyond_training_range"] == beyond
     assert main(["residuals", str(model), str(data_csv)]) == 0
     assert "beyond" not in capsys.readouterr().out
+
+
+def test_identify_with_hinging_on_the_tank_and_its_partition_column(tmp_path, capsys):
+    """`--segmentation hinging`: the tank that empties and overflows, its hinges the two
+    saturations; the model file validates; `--partition-column u(k-1)` (refused before with a
+    method that returns its partition) leaves the hinges on that column only."""
+    rng = np.random.default_rng(0)
+    n = 2000
+    u = np.repeat(rng.uniform(-1.2, 1.2, n // 30 + 1), 30)[:n]
+    y = np.zeros(n)
+    for k in range(1, n):
+        y[k] = min(10.0, max(0.0, y[k - 1] + 0.2 * u[k - 1]))
+    data = tmp_path / "tank.csv"
+    write_csv(data, {"time_s": np.arange(n) * 0.1, "u": u, "y": y + 0.05 * rng.standard_normal(n)})
+    out = tmp_path / "t.json"
+    args = ["identify", str(data), "--input", "u", "--output", "y", "--na", "1", "--nb", "1",
+            "--segmentation", "hinging", "--regions", "3"]
+    assert main([*args, "--out", str(out)]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["segmentation"] == "hinging" and summary["n_regions"] == 3
+    assert summary["train_fit_percent"] > 90
+    assert main(["validate", str(out), str(data), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["fit_percent"] == pytest.approx(summary["train_fit_percent"], abs=0.01)
+    assert main([*args, "--partition-column", "u", "--out", str(out)]) == 0
+    capsys.readouterr()
+    polyhedra = json.loads(out.read_text())["partition"]["polyhedra"]
+    # regressor columns y(k-1), u(k-1): every boundary's weight on y(k-1) is zero
+    assert all(row[0] == 0 for p in polyhedra for row in p["H"])
+    assert any(row[1] != 0 for p in polyhedra for row in p["H"])
