@@ -129,12 +129,14 @@ def mode_pieces(Z, mode, K, n_neighbors, min_rows):
     sets of a 5-slab instance, through the sparse corners of the regressor space.)"""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
-    from sklearn.neighbors import NearestNeighbors
+    from scipy.spatial import cKDTree
 
     n = Z.shape[0]
     c = min(int(n_neighbors) + 1, n)
-    nn = NearestNeighbors(n_neighbors=c).fit(Z)
-    idx = nn.kneighbors(Z, return_distance=False)
+    # scipy's k-d tree, not scikit-learn's NearestNeighbors: the same neighbours without the
+    # estimator's validation and joblib dispatch on each of the ~120 queries of a search
+    tree = cKDTree(Z)
+    idx = tree.query(Z, k=c)[1].reshape(n, c)
     # core rows: most of their nearest rows are of their mode (a stray label inside another
     # mode's region is not one, and would otherwise link two pieces across that region)
     core = np.mean(mode[idx[:, 1:]] == mode[:, None], axis=1) > 0.5 if c > 1 else np.ones(n, bool)
@@ -146,7 +148,7 @@ def mode_pieces(Z, mode, K, n_neighbors, min_rows):
     # rows are sparse, a row's nearest rows of its mode may lie across another mode's slab
     sight = np.ones(src.size, dtype=bool)
     for t in (SIGHT_POINTS if src.size else ()):
-        near = nn.kneighbors((1.0 - t) * Z[src] + t * Z[dst], n_neighbors=min(3, n), return_distance=False)
+        near = tree.query((1.0 - t) * Z[src] + t * Z[dst], k=min(3, n))[1].reshape(src.size, -1)
         other = (near != src[:, None]) & (near != dst[:, None])  # the link's own ends do not count
         mid = near[np.arange(near.shape[0]), np.argmax(other, axis=1)]
         sight &= (mode[mid] == mode[src]) | ~other.any(axis=1)
@@ -167,7 +169,7 @@ def mode_pieces(Z, mode, K, n_neighbors, min_rows):
         stray = np.flatnonzero((mode == m) & ~keep)
         home = np.flatnonzero((mode == m) & keep)
         if stray.size and home.size:
-            near = NearestNeighbors(n_neighbors=1).fit(Z[home]).kneighbors(Z[stray], return_distance=False)[:, 0]
+            near = cKDTree(Z[home]).query(Z[stray], k=1)[1].reshape(-1)
             piece[stray] = piece[home[near]]
     return owner, piece
 
