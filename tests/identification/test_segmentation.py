@@ -594,6 +594,10 @@ def test_hinging_recovers_a_noise_free_hinge_exactly_and_checks_its_settings():
         make_segmenter("hinging", n_starts=0).segment(X, t, 2, None, 0)
     one = make_segmenter("hinging").segment(X, t, 1, None, 0)
     assert one.n_regions == 1 and np.all(one.labels == 0)
+    # two hinges that cross inside the data: four sign patterns, the three most populated kept
+    cross = 0.5 * X[:, 0] + np.maximum(0.0, X[:, 0] - 0.2) + 1.5 * np.maximum(0.0, X[:, 1] + 0.1)
+    three = make_segmenter("hinging").segment(X, cross, 3, None, 0)
+    assert three.n_regions == 3 and three.info["patterns_dropped"] == 1
     # the hinge's directions on the allowed columns only (a PWARX's partition_columns)
     cut = make_segmenter("hinging").segment(X, t, 2, None, 0, columns=[1])
     assert cut.n_regions == 2 and np.all(cut.partition.H[0][:, 0] == 0)
