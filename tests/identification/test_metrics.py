@@ -97,5 +97,11 @@ def test_held_out_fit_is_the_blocks_own_fit_or_against_the_whole_spread_where_th
     assert held_out_fit(nearly, nearly + 0.1 * spread, spread) == pytest.approx(90.0)
     with pytest.raises(DataError, match="empty"):
         held_out_fit([], [], spread)
+    # a simulation scores a block so when given the record's spread (the search's one path)
+    from hwpts.identification.simulation import SimulationResult
+
+    run = SimulationResult(np.concatenate([[0.0], rest + 0.1 * spread]), np.zeros(51, dtype=int), 1)
+    assert run.score(np.zeros(51), spread) == pytest.approx(90.0)
+    assert np.isnan(SimulationResult(np.zeros(51), np.zeros(51, dtype=int), 1, diverged=True).score(y[:51], spread))
     with pytest.raises(DataError, match="an output that varies"):
         held_out_fit(rest, rest, 0.0)

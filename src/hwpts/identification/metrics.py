@@ -92,14 +92,16 @@ def held_out_fit(measured, predicted, spread) -> float:
     >>> round(held_out_fit([0.0, 0.0], [0.0, 0.5], spread=1.0), 3)
     64.645
     """
+    if not spread > 0:
+        raise DataError(f"a held-out fit needs the spread of an output that varies, got {spread!r}")
+    y = np.asarray(measured, dtype=float)
+    if y.size and np.all(np.isfinite(y)):
+        top = max(float(np.max(np.abs(y))), float(spread))
+        if np.std(y / top) > REST * spread / top:  # it moves: its own fit %, validated there
+            return fit_percent(measured, predicted)
     y, yhat = _pair(measured, predicted)
     if not np.all(np.isfinite(yhat)):
         return float("nan")
-    if not spread > 0:
-        raise DataError(f"a held-out fit needs the spread of an output that varies, got {spread!r}")
-    scale = max(float(np.max(np.abs(y))), float(spread))
-    if np.std(y / scale) > REST * spread / scale:
-        return fit_percent(y, yhat)
     # scaled first: the squares of a 1e160 signal overflow (fit_percent does the same)
     scale = max(float(np.max(np.abs(y))), float(np.max(np.abs(yhat))), float(spread))
     rmse = float(np.sqrt(np.mean(((y - yhat) / scale) ** 2)))

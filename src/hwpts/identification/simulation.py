@@ -47,10 +47,13 @@ class SimulationResult:
     diverged_at: int | None = None
     reason: str | None = None
 
-    def score(self, measured) -> float:
+    def score(self, measured, spread=None) -> float:
         """Free-run fit % (NRMSE) against the ``measured`` output after the initial conditions;
-        ``nan`` when the run diverged (the one encoding of "diverged" in the package)."""
-        from hwpts.identification.metrics import fit_percent
+        ``nan`` when the run diverged (the one encoding of "diverged" in the package). With
+        ``spread`` (the standard deviation of a whole record this is a block of), a model search's
+        held-out score (:func:`~hwpts.identification.metrics.held_out_fit`: a block where the
+        output rests is measured against that spread)."""
+        from hwpts.identification.metrics import fit_percent, held_out_fit
 
         y = dense_real(measured, "measured")
         if y.ndim == 2 and y.shape[1] == 1:
@@ -63,6 +66,8 @@ class SimulationResult:
         if y.shape[0] - m < 2:  # said as the signal being empty or constant before
             raise DataError(f"a fit % needs at least 2 samples after the {m} initial conditions, got "
                             f"{max(y.shape[0] - m, 0)}")
+        if spread is not None:
+            return held_out_fit(y[m:], self.output[m:], spread)
         return fit_percent(y[m:], self.output[m:])
 
 

@@ -207,32 +207,29 @@ def _candidate(estimator, params):
     return model
 
 
-def _score_split(model, u, y, train, test, names=None, output_name=None):
+def _score_split(model, u, y, train, test, names=None, output_name=None, spread=None):
     """Free-run fit % of the candidate ``model`` (:func:`_candidate`) fitted on ``train``, simulated
-    over ``test`` (nan if diverged). One model is fitted on every fold in turn (a fit replaces every
+    over ``test`` (nan if diverged; ``spread``: ``y``'s, :func:`_block_fits`). One model is fitted on every fold in turn (a fit replaces every
     fitted attribute; cloning it for each fold took 0.1 s of a Silverbox search)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         model.fit(u[train], y[train], names, output_name, breaks=breaks_of(train) or None)
-        free, one = _block_fits(model, u, y, test)
+        free, one = _block_fits(model, u, y, test, output_spread(y) if spread is None else spread)
     return free, one, int(model.n_regions_)
 
 
-def _block_fits(model, u, y, test):
+def _block_fits(model, u, y, test, spread):
     """``(free run, one-step)`` fit % of a fitted ``model`` on the held-out block ``test``
-    (:func:`~hwpts.identification.metrics.held_out_fit`, the spread of all of ``y`` where the
+    (:func:`~hwpts.identification.metrics.held_out_fit`: ``spread``, all of ``y``'s, where the
     output rests over the block): simulated from the block's first
     measured outputs (free run ``nan`` if it diverged); a static map (no lagged signal) on any rows,
     where the free run is the one-step prediction."""
-    spread = output_spread(y)
     if model.structure_.max_lag == 0:
-        sim = model.simulate(u[test], y[test])
-        score = float("nan") if sim.diverged else held_out_fit(y[test], sim.output, spread)
+        score = model.simulate(u[test], y[test]).score(y[test], spread)
         return score, score
     rows = slice(int(test[0]), int(test[-1]) + 1)
     m = model.structure_.max_lag
-    sim = model.simulate(u[rows], y[rows])
-    free = float("nan") if sim.diverged else held_out_fit(y[rows][m:], sim.output[m:], spread)
+    free = model.simulate(u[rows], y[rows]).score(y[rows], spread)
     return free, held_out_fit(y[rows][m:], model.predict(u[rows], y[rows])[m:], spread)
 
 
@@ -293,10 +290,11 @@ def _evaluate(estimator, params, u, y, splits, prune_below=-np.inf, names=None, 
     fits, regions, ones = [], [], []
     stop = error = None
     number = 0  # the fold being fitted: a failure on a fold's rows is not one on the user's whole data
+    spread = output_spread(y)  # (once a candidate, not once a block)
     try:
         model = _candidate(estimator, params)
         for number, (train, test) in enumerate(splits, start=1):
-            fit, one, s = _score_split(model, u, y, train, test, names, output_name)
+            fit, one, s = _score_split(model, u, y, train, test, names, output_name, spread)
             fits.append(fit)
             ones.append(one)
             regions.append(s)
@@ -1371,8 +1369,9 @@ class PWARXSearch(BaseEstimator):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             fits = []
+            spread = output_spread(y)
             for _, test in splits:
-                free, one = _block_fits(model, u, y, test)
+                free, one = _block_fits(model, u, y, test, spread)
                 if not np.isfinite(free):
                     return None, "the refit on all data diverges in free run on a block", []
                 fits.append(one if self.scoring_ == "one_step" else free)
