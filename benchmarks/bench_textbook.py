@@ -17,7 +17,8 @@ search told the plant's orders, one ARX model of those orders (``nan``: its free
 the search's time and choice.
 
 ``python -m benchmarks textbook [--seeds=N] [--systems=a,b]`` (1 seed by default);
-``--methods [--seeds=5]``: the tank's three segmentation methods side by side (:func:`tank_methods`).
+``--methods [--seeds=5] [--samples=N]``: the tank's segmentation methods side by side on N
+training samples (3,000; :func:`tank_methods`).
 """
 
 from __future__ import annotations
@@ -102,8 +103,8 @@ def data(name, seed, n):
     return (u, simulate(name, u, e)), (uv, simulate(name, uv))
 
 
-def tank_methods(seeds) -> None:
-    """``--methods``: on ``integrator_sat`` (3,000 samples, the true orders 1/1/1, 3 regions), per
+def tank_methods(seeds, n=3000) -> None:
+    """``--methods``: on ``integrator_sat`` (``n`` samples, the true orders 1/1/1, 3 regions), per
     seed, the free-run fit % of ``threshold``, ``alternating``, ``hinging`` (two hinges of a
     continuous PWA map) and ``threshold-alternating`` on the noise-free validation record; the alternation's objective where ``alternating`` landed, where
     ``threshold-alternating`` landed (from the split), and at the true modes' labels; and the
@@ -111,12 +112,12 @@ def tank_methods(seeds) -> None:
     from hwpts.identification import PWARX
     from hwpts.identification.segmentation.alternating import _objective, scaled_problem
 
-    print("integrator_sat, 3,000 samples, na 1, nb 1, nk 1, 3 regions: free-run fit % (noise-free validation); "
+    print(f"integrator_sat, {n:,} samples, na 1, nb 1, nk 1, 3 regions: free-run fit % (noise-free validation); "
           "alternation objective; boundary weight ratio |w_u / w_y|")
     print(f"{'seed':>4s} {'threshold':>10s} {'alternating':>12s} {'hinging':>8s} {'thr-alt':>8s}   {'obj alt':>8s} {'obj thr-alt':>11s} "
           f"{'obj true':>9s}   ratio")
     for seed in seeds:
-        (u, y), (uv, yv) = data("integrator_sat", seed, 3000)
+        (u, y), (uv, yv) = data("integrator_sat", seed, n)
         fits, objective = {}, {}
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -143,7 +144,8 @@ def main(argv=None) -> int:
     seeds, names = parsed
     seeds = seeds if any(a.startswith("--seeds=") for a in argv or []) else [0]
     if "--methods" in (argv or []):
-        tank_methods(seeds)
+        sizes = [int(a.split("=", 1)[1]) for a in argv if a.startswith("--samples=")]
+        tank_methods(seeds, sizes[-1] if sizes else 3000)
         return 0
     print(f"free-run fit % on noise-free validation, median [min, max] over {len(seeds)} seed(s); "
           f"noise {NOISE:.0%} of the output's std (equation error)")

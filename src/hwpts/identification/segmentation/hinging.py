@@ -10,8 +10,8 @@ of two modes. Where the system is continuous (a saturation, a dead zone, a tank 
 overflows) that is what decides the boundaries. On the tank of ``python -m benchmarks textbook``
 (``y(k) = min(10, max(0, y(k-1) + 0.2 u(k-1)))``, the true orders, 3 regions), whose threshold split on
 ``y(k-1)`` cannot leave the empty tank (its lower piece maps every input to ~0), the free-run fit on
-the noise-free validation records over seeds 0-4 was (``--methods --seeds=5`` prints the 3,000-sample
-rows):
+the noise-free validation records over seeds 0-4 was (``--methods --seeds=5`` prints the rows,
+``--samples=300`` the first):
 
 =========  ==================================  ==================================
 samples    ``hinging``                         ``threshold-alternating`` / ``threshold``
@@ -21,7 +21,7 @@ samples    ``hinging``                         ``threshold-alternating`` / ``thr
 =========  ==================================  ==================================
 
 On the zoo's continuous maps (``../shared/benchmarks/pwarx_zoo.py``, told the number of regions,
-seeds 0-4, one-step fit on noise-free validation): ``hharx_roll`` (a hinge, 40 samples) 100.0 % on
+seeds 0-4, one-step fit on noise-free validation; a script not kept): ``hharx_roll`` (a hinge, 40 samples) 100.0 % on
 every seed (``alternating`` 98.8-99.9, ``threshold`` 88.2-91.1); ``parc_sin2d`` (a smooth surface,
 10 regions) median 91.1 % (``alternating`` 92.2, ``threshold`` 61.0): nine hinges crossing in the
 plane make more pieces than the 10 regions kept (with every populated pattern a region, as a first
