@@ -65,13 +65,19 @@ def _load(spec, u_name, y_name):
     return np.asarray(cols[u_name], float)[rows][:, None], np.asarray(cols[y_name], float)[rows]
 
 
-def _beyond(u, y, ut, yt) -> str:
-    """Each signal's share of the test record outside its range over the training part ("" if none)."""
-    u, ut = np.asarray(u, float).reshape(len(y), -1), np.asarray(ut, float).reshape(len(yt), -1)
-    pairs = [(f"u{j + 1}" if u.shape[1] > 1 else "u", u[:, j], ut[:, j]) for j in range(u.shape[1])]
-    pairs.append(("y", np.asarray(y, float), np.asarray(yt, float)))
-    shares = [(name, float(np.mean((t < a.min()) | (t > a.max())))) for name, a, t in pairs]
-    return ", ".join(f"{name} {100 * s:.2g} %" for name, s in shares if s > 0)
+def _beyond(model, ut, yt) -> str:
+    """Each signal's share of the test record outside the range the model was identified on (""
+    if none): ``hwpts validate``'s count (:func:`hwpts.identification.analysis.beyond_training_range`),
+    the input named ``u`` as in the data files."""
+    from hwpts.identification.analysis import beyond_training_range
+
+    shares = beyond_training_range(model, ut, yt)
+    output = shares.pop(model.structure_.output_name, None)  # the inputs first, the output last
+    if output is not None:
+        shares["y"] = output
+    label = {"u1": "u"} if len(shares) == 2 else {}
+    return ", ".join(f"{label.get(name, name)} {100 * v['share']:.2g} %" for name, v in shares.items()
+                     if v["share"] > 0)
 
 
 def _score(cfg, y, yhat, n0):
@@ -181,7 +187,7 @@ def main(argv=None) -> int:
             unit = "" if cfg["metric"] == "fit" else " " + cfg["unit"]
             print(f"{name:19s} {test:10s} {a:8.2f} {h:8.2f} {target:7.2f} {'yes' if met else 'no':>4s} "
                   f"{elapsed:8.1f}  {chosen} | {cfg['published'][test]}{unit}", flush=True)
-            outside = _beyond(u, y, ut, yt)
+            outside = _beyond(model, ut, yt)
             if outside:  # what no held-out block of the training part can show the search
                 print(f"{'':19s} {'':10s} test samples beyond the training range: {outside}", flush=True)
             status_lines.append((name, test, met))

@@ -922,20 +922,10 @@ def _beyond_line(shares: dict) -> str:
 
 
 def _beyond_training(model, data) -> dict:
-    """Each signal's share of the samples (after the initial conditions) outside the range the model
-    was identified on, with that range: a PWA model extrapolates its outer pieces there, which a fit %
-    alone does not say (a tank model identified below its overflow level, validated above it)."""
-    st = model.structure_
-    m = st.max_lag
-    ranges = [(st.output_name, model.output_range_, data.output[m:]),
-              *((name, r, data.inputs[m:, j]) for j, (name, r) in enumerate(zip(st.input_names, model.input_ranges_)))]
-    out = {}
-    for name, (lo, hi), values in ranges:
-        if not (abs(lo) < 1e299 and abs(hi) < 1e299):
-            continue  # a model file without its ranges (nan, or the +-1e300 of PWARX.from_parts)
-        out[name] = {"share": round(float(np.mean((values < lo) | (values > hi))), 6),
-                     "training_range": [float(lo), float(hi)]}
-    return out
+    """:func:`~hwpts.identification.analysis.beyond_training_range` of ``model`` on ``data``."""
+    from hwpts.identification.analysis import beyond_training_range
+
+    return beyond_training_range(model, data.inputs, data.output)
 
 
 def _check_mapped_units(model, inputs, output) -> None:

@@ -22,7 +22,29 @@ from scipy.stats import norm
 
 from hwpts.errors import DataError, ParameterError
 
-__all__ = ["to_control", "mode_initial_state", "ResidualAnalysis", "residual_analysis", "correlation"]
+__all__ = ["to_control", "mode_initial_state", "ResidualAnalysis", "residual_analysis", "correlation",
+           "beyond_training_range"]
+
+
+def beyond_training_range(model, inputs, output) -> dict:
+    """``{signal name: {"share", "training_range"}}``: each signal's share of the samples (after the
+    model's initial conditions) outside the range the fitted ``model`` was identified on, with that
+    range. A PWA model extrapolates its outer pieces there, which a fit % alone does not say (a tank
+    model identified below its overflow level, validated above it). Signals whose range the model
+    does not hold (a model file without it, or ``PWARX.from_parts``'s +-1e300) are left out."""
+    st = model.structure_
+    m = st.max_lag
+    u = np.asarray(inputs, dtype=float).reshape(len(output), -1)
+    y = np.asarray(output, dtype=float)
+    ranges = [(st.output_name, model.output_range_, y[m:]),
+              *((name, r, u[m:, j]) for j, (name, r) in enumerate(zip(st.input_names, model.input_ranges_)))]
+    out = {}
+    for name, (lo, hi), values in ranges:
+        if not (abs(lo) < 1e299 and abs(hi) < 1e299):
+            continue
+        out[name] = {"share": round(float(np.mean((values < lo) | (values > hi))), 6),
+                     "training_range": [float(lo), float(hi)]}
+    return out
 
 
 def _control():
