@@ -361,6 +361,30 @@ def test_switched_merges_parts_where_splits_stop_short():
     assert fit_percent(yv, model.predict(uv, yv)) > 97
 
 
+def test_the_last_hard_em_on_all_rows_never_lowers_the_own_mode_share():
+    """A split's or the merges' classifier goes through a last hard EM on all rows, kept only where
+    it does not lower the share of rows put into a region of their own mode (the EM climbs the
+    likelihood of the region labels, not that share: on a rand_vor5_d2 set it lowered the share
+    from 0.9917 to 0.9763 and the one-step fit from 98.1 to 92.3 %)."""
+    from hwpts.identification.segmentation.switched import _no_worse
+
+    class Fixed:  # a classifier that puts every row in one region
+        def __init__(self, region):
+            self.region = region
+
+        def predict(self, Z):
+            return np.full(len(Z), self.region)
+
+    Z, owner, mode = np.zeros((10, 2)), np.array([0, 1]), np.array([0] * 7 + [1] * 3)
+    worse, better = Fixed(1), Fixed(0)  # shares 0.3 and 0.7
+    assert _no_worse(worse, better, Z, owner, mode) == (better, 0.7)
+    assert _no_worse(better, worse, Z, owner, mode) == (better, 0.7)
+    u, y = _voronoi_map(2000, 0)
+    history = PWARX(0, 1, 0, n_regions=2, segmentation="switched", random_state=0).fit(u, y) \
+        .segmentation_info_["own_mode_share"]
+    assert history[-1] >= history[-2]
+
+
 def test_switched_fit_percent_is_the_in_sample_fit_of_the_best_switched_models():
     from hwpts.identification.segmentation.switched import switched_fit_percent
 
