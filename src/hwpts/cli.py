@@ -113,7 +113,16 @@ def _same_file(a, b) -> bool:
 
 
 def _check_outputs(args) -> None:
-    """An output that is one of the command's inputs is refused (it would destroy the input)."""
+    """An output that is one of the command's inputs is refused (it would destroy the input), and
+    so is an input path that is not UTF-8 (as an output path is: its name goes into summaries and
+    reports, which are UTF-8 text; it was read and its name written as a lone surrogate, which a
+    strict JSON reader refuses)."""
+    from hwpts.io.atomic import check_utf8_path
+
+    for name in INPUT_ARGS:
+        source = getattr(args, name, None)
+        if source is not None:
+            check_utf8_path(source, f"--{name}" if name == "inputs" else name.upper())
     for flag in OUTPUT_ARGS:
         out = getattr(args, flag, None)
         if out is None or str(out) == "-":

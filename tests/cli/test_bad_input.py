@@ -129,6 +129,8 @@ def workspace(tmp_path_factory):
                              "y": pa.array([], pa.float64())}), ws / "zero.parquet")
     savemat(ws / "ragged.mat", {"u1": np.arange(10.0), "u2": np.arange(10.0), "y": np.arange(12.0)})
     savemat(ws / "good.mat", {"u1": d.inputs[:, 0], "u2": d.inputs[:, 1], "y": d.output})
+    savemat(ws / "tsvec.mat", {"u1": d.inputs[:, 0], "u2": d.inputs[:, 1], "y": d.output, "Ts": [0.01, 0.02]})
+    (ws / "lat\udce9.csv").write_bytes((ws / "data.csv").read_bytes())  # the byte 0xe9 in the name
     (ws / "folder").mkdir()
     os.mkfifo(ws / "fifo.csv")  # reading one would block forever
     os.mkfifo(ws / "fifo.json")
@@ -166,8 +168,24 @@ CASES = [
       "--all-partition-columns", "--out", f"{W}/m.json"],
      "--all-partition-columns keeps every regressor column in a learned classifier's boundaries; --segmentation "
      "threshold makes its partition without one"),
-    (["identify", f"{W}/data.csv", *FIT, "--na", "1", "--nb", "1", "--hyperplane", "1,0,0,0,0", "--all-partition-columns",
+    (["identify", f"{W}/data.csv", *FIT, "--na", "1", "--nb", "1", "--hyperplane", "1,0", "--all-partition-columns",
       "--out", f"{W}/m.json"], "--segmentation hyperplane makes its partition without one"),
+    # --- found by a review (2026-11-28): with the orders searched, a hyperplane no candidate has
+    # and orders no training part can fit failed in every fold ("every candidate model diverged in
+    # free run or failed: unknown regressor column 'foo' ..."), naming neither option; an input
+    # path that is not UTF-8 was read (its name a lone surrogate in the JSON summary); a .mat
+    # file's vector Ts was passed over (the model's sample time null)
+    (["identify", f"{W}/data.csv", *FIT, "--hyperplane=1,0,0@foo,u1", "--out", f"{W}/m.json"],
+     "--hyperplane 1,0,0@foo,u1: expected regressor columns after '@'"),
+    (["identify", f"{W}/data.csv", *FIT, "--hyperplane", "0,0,0,1", "--out", f"{W}/m.json"],
+     "--hyperplane 0,0,0,1: expected at most 2 coefficients and the offset"),
+    (["identify", f"{W}/data.csv", *FIT, "--na", "90", "--nb", "90", "--out", f"{W}/m.json"],
+     "--na 90 --nb 90 --nk 1: expected orders whose model can be fitted in the search's cross-validation"),
+    (["identify", f"{W}/lat\udce9.csv", *FIXED, "--out", f"{W}/m.json"],
+     "DATA '{ws}/lat\\xe9.csv': the path holds bytes that are not UTF-8"),
+    (["validate", f"{W}/model.json", f"{W}/lat\udce9.csv"], "DATA '{ws}/lat\\xe9.csv': the path holds bytes"),
+    (["identify", f"{W}/tsvec.mat", *FIXED, "--out", f"{W}/m.json"],
+     "the variable 'Ts' is taken as the sample time in seconds; expected a positive number, got 2 values"),
     (["identify", f"{W}/data.csv", *FIT, "--na", "1", "--nb", "1", "--segmentation", "average", "--all-partition-columns",
       "--out", f"{W}/m.json"], "--segmentation average makes its partition without one"),
     (["predict", f"{W}/model.json", f"{W}/data.csv", "--out", f"{W}/hardlink.csv"],

@@ -845,3 +845,12 @@ def test_identify_with_hinging_on_the_tank_and_its_partition_column(tmp_path, ca
     # regressor columns y(k-1), u(k-1): every boundary's weight on y(k-1) is zero
     assert all(row[0] == 0 for p in polyhedra for row in p["H"])
     assert any(row[1] != 0 for p in polyhedra for row in p["H"])
+
+
+def test_a_share_beyond_the_training_range_reads_as_a_percentage():
+    """All of a record beyond the training range read "'y' 1e+02 %" (two significant digits)."""
+    from hwpts.commands.model import _beyond_line
+
+    line = _beyond_line({"y": {"share": 1.0, "training_range": [0.0, 1.0]},
+                         "u": {"share": 0.0037, "training_range": [-1.0, 1.0]}})
+    assert "'y' 100 % (identified on 0 to 1)" in line and "'u' 0.37 %" in line

@@ -664,3 +664,13 @@ def test_an_offset_that_leaves_the_model_too_few_digits_is_refused():
     base = PWARX(1, 1, 1, n_regions=1, segmentation="average").fit(u, y)
     shifted = PWARX(1, 1, 1, n_regions=1, segmentation="average").fit(u, y + 1e8)
     assert shifted.score(u, y + 1e8) == pytest.approx(base.score(u, y), abs=1e-3)
+
+
+def test_search_counts_the_regressor_rows_of_its_smallest_training_part():
+    """300 samples, lags of 60: 4 blocks of 75; a middle block held out leaves 225 samples in two
+    stretches, each losing its 60 initial conditions: 105 rows, what PWARX.fit reports at the break
+    (``hwpts identify --na 60 --nb 60`` on 300 rows is refused up front with that count)."""
+    search = PWARXSearch(PWARX())
+    assert search.n_training_rows(300, 60) == 225
+    assert search.n_regressor_rows(300, 60) == 105
+    assert search.n_regressor_rows(300, 60, model_lag=1) == 225 - 2

@@ -277,7 +277,13 @@ def _mat_sample_time(path, columns) -> tuple[str, float] | None:
                                 f"column, or --time none for the sample index)")
             continue
         if np.size(value) != 1:  # a signal of that name (a vector 'dt'), not a sample time
-            continue
+            if any(other != name and np.size(v) == np.size(value) for other, v in columns.items()):
+                continue
+            # as long as no signal: not one, and no sample time either (it was passed over: the
+            # model's sample_time_s null where the file meant Ts)
+            raise DataError(f"{str(path)!r}: the variable {name!r} is taken as the sample time in seconds; expected "
+                            f"a positive number, got {np.size(value)} values (as long as no signal of the file; pass "
+                            f"--time COL for a time column, or --time none for the sample index)")
         value = float(np.asarray(value, dtype=float).reshape(-1)[0])
         if not (np.isfinite(value) and value > 0):
             raise DataError(f"{str(path)!r}: the variable {name!r} is taken as the sample time in seconds; expected "
@@ -538,23 +544,37 @@ def _orders_to_search(args):
     return fixed, searched
 
 
-def _check_fixed_lags(fixed, searched, n_samples, name) -> None:
+def _check_fixed_lags(fixed, searched, n_samples, name, n_inputs=1) -> None:
     """Orders given (``--na``...) whose lags leave the record too short for the model search that
-    chooses the others (2 held-out blocks of the lags plus MIN_BLOCK samples) are said as those
-    options (the search's message asked for the settings the user had given)."""
+    chooses the others (2 held-out blocks of the lags plus MIN_BLOCK samples), or whose smallest
+    candidate has more parameters than the training part of the search's cross-validation has
+    samples (every candidate failed: ``--na 90 --nb 90`` on 300 rows), are said as those options
+    (the search's message asked for the settings the user had given)."""
     from hwpts.identification import PWARX, PWARXSearch
+    from hwpts.identification.regressors import RegressorStructure
     from hwpts.identification.selection.search import MIN_BLOCK, ORDER_GRID, expand_grid
 
     def largest_lag(grid):  # as the search finds it (PWARXSearch.fit: the largest over its order grid)
         return max(PWARXSearch._max_lag(PWARX(), orders) for orders in expand_grid(grid))
 
+    flags = {"output_order": "--na", "input_order": "--nb", "input_delay": "--nk"}
+    given = " ".join(f"{flags[k]} {','.join(str(v) for v in np.atleast_1d(fixed[k]))}" for k in ORDER_GRID if k in fixed)
     lag = largest_lag({k: [fixed[k]] if k in fixed else list(searched[k]) for k in ORDER_GRID})
     if n_samples // (MIN_BLOCK + lag) >= 2:
+        smallest = {k: fixed[k] if k in fixed else min(searched[k]) for k in ORDER_GRID}
+        structure = RegressorStructure.create(smallest["output_order"], smallest["input_order"],
+                                              smallest["input_delay"], n_inputs, True)
+        rows = PWARXSearch(PWARX()).n_regressor_rows(n_samples, lag, structure.max_lag)
+        if rows < structure.n_parameters + 1:  # PWARX.fit's own limit at the breaks
+            raise ParameterError(f"{given}: expected orders whose model can be fitted in the search's cross-"
+                                 f"validation on the {n_samples} samples of {name} (each candidate is fitted "
+                                 f"without a held-out block, each stretch after its {structure.max_lag} initial "
+                                 f"conditions: {max(rows, 0)} regressor rows), got orders whose smallest candidate "
+                                 f"({structure.describe_orders()}) has {structure.n_parameters} parameters and needs "
+                                 f"{structure.n_parameters + 1} rows; give smaller orders, or every order")
         return
     if n_samples // (MIN_BLOCK + largest_lag({k: list(searched.get(k, ORDER_GRID[k])) for k in ORDER_GRID})) < 2:
         return  # too short whatever the orders: the search says so
-    flags = {"output_order": "--na", "input_order": "--nb", "input_delay": "--nk"}
-    given = " ".join(f"{flags[k]} {','.join(str(v) for v in np.atleast_1d(fixed[k]))}" for k in ORDER_GRID if k in fixed)
     raise ParameterError(f"{given}: expected orders whose largest lag is at most {n_samples // 2 - MIN_BLOCK} for the "
                          f"{n_samples} samples of {name} (the search that chooses the other orders holds out 2 "
                          f"blocks of the lags + {MIN_BLOCK} samples and fits each candidate on the rest), got a "
@@ -615,13 +635,44 @@ def _check_signals(inputs, output) -> None:
 def _check_partition_columns(args, fixed, searched, powers=()) -> None:
     """Every ``--partition-column`` names a regressor column of some candidate structure (the
     largest orders of the search, each delay), so a misspelt name fails at once and names the flag."""
-    from hwpts.identification.regressors import RegressorStructure
-
     if not args.partition_column:
         return
     twice = next((c for i, c in enumerate(args.partition_column) if c in args.partition_column[:i]), None)
     if twice is not None:  # (stored twice, while --input u --input u is refused)
         raise ParameterError(f"--partition-column {twice!r} is given twice; give each column once")
+    names = _candidate_columns(args, fixed, searched, powers)
+    valid = {*names, *args.input, args.output}
+    for name in args.partition_column:
+        if name not in valid:
+            raise ParameterError(f"--partition-column {name!r} is not a regressor column; valid names are "
+                                 f"{names} or the signals {[*args.input, args.output]}")
+
+
+def _check_hyperplanes(args, hyperplanes, fixed, searched, powers=()) -> None:
+    """Every ``--hyperplane`` fits some candidate structure: by position, at most one coefficient
+    an input; by name (``@col1,col2``), regressor columns of the largest orders of the search. Said
+    at once and as the option: inside the search every candidate failed with a message of the
+    cross-validation's folds."""
+    names = None
+    for text, plane in zip(args.hyperplane, hyperplanes):
+        if plane.columns is None:
+            if len(plane.coefficients) > len(args.input):
+                raise ParameterError(f"--hyperplane {text}: expected at most {len(args.input)} coefficient"
+                                     f"{'s' if len(args.input) > 1 else ''} and the offset (by position, the "
+                                     f"coefficients are of the inputs {args.input}; name other regressor columns "
+                                     f"with '@col1,col2'), got {len(plane.coefficients)} coefficients")
+            continue
+        names = names if names is not None else _candidate_columns(args, fixed, searched, powers)
+        missing = [c for c in plane.columns if c not in {*names, *args.input, args.output}]
+        if missing:
+            raise ParameterError(f"--hyperplane {text}: expected regressor columns after '@' ({names}) or the "
+                                 f"signals {[*args.input, args.output]}, got {', '.join(map(repr, missing))}")
+
+
+def _candidate_columns(args, fixed, searched, powers=()) -> list:
+    """The regressor columns of the search's candidate structures (the largest orders, each delay)."""
+    from hwpts.identification.regressors import RegressorStructure
+
     na = fixed.get("output_order", max(searched.get("output_order", [0])))
     nb = fixed.get("input_order", max(searched.get("input_order", [1])))
     delays = [fixed["input_delay"]] if "input_delay" in fixed else list(searched.get("input_delay", [1]))
@@ -630,11 +681,7 @@ def _check_partition_columns(args, fixed, searched, powers=()) -> None:
         structure = RegressorStructure.create(na, nb, nk, len(args.input), True, args.input, args.output,
                                               powers if na >= 1 else ())
         names += [name for name in structure.feature_names if name not in names]
-    valid = {*names, *args.input, args.output}
-    for name in args.partition_column:
-        if name not in valid:
-            raise ParameterError(f"--partition-column {name!r} is not a regressor column; valid names are "
-                                 f"{names} or the signals {[*args.input, args.output]}")
+    return names
 
 
 def cmd_identify(args) -> int:
@@ -675,6 +722,7 @@ def cmd_identify(args) -> int:
                                               given_powers)
         structure.check_length(data.n_samples, what=_selection(args, repr(str(args.data))))
     hyperplanes = [Hyperplane.parse(h) for h in args.hyperplane]
+    _check_hyperplanes(args, hyperplanes, fixed, searched, given_powers)
     segmentation = args.segmentation
     if hyperplanes and segmentation is None:
         segmentation = "hyperplane"
@@ -717,9 +765,11 @@ def cmd_identify(args) -> int:
     if args.shared_modes == "on" and segmentation != "auto":  # (it was ignored)
         raise ParameterError(f"--shared-modes on: the search tries the switched segmentation beside its methods; "
                              f"--segmentation {segmentation} fixes the method (leave one of them out)")
-    if not fixed_partition and searched and fixed:
+    will_search = bool(searched) or (segmentation == "auto" and n_regions != 1) or (n_regions == "auto"
+                                                                                   and not fixed_partition)
+    if not fixed_partition and will_search and fixed:
         # (a fixed partition's grid search splits by the given orders' lags alone)
-        _check_fixed_lags(fixed, searched, data.n_samples, _selection(args, repr(str(args.data))))
+        _check_fixed_lags(fixed, searched, data.n_samples, _selection(args, repr(str(args.data))), len(args.input))
     if not fixed_partition:
         _check_region_count(n_regions, data.n_samples, fixed, searched, len(args.input),
                             searching=bool(searched) or segmentation == "auto",
@@ -914,9 +964,14 @@ def _validate_numbers(model, data):
     return result
 
 
+def _percent(value: float) -> str:
+    """A share in % with two significant digits, whole from 10 on (``100``, not ``1e+02``)."""
+    return f"{value:.0f}" if value >= 10 else f"{value:.2g}"
+
+
 def _beyond_line(shares: dict) -> str:
     """The line that says :func:`_beyond_training`'s shares, or "" where no sample lies outside."""
-    beyond = [f"{name!r} {100 * v['share']:.2g} % (identified on {v['training_range'][0]:.4g} to "
+    beyond = [f"{name!r} {_percent(100 * v['share'])} % (identified on {v['training_range'][0]:.4g} to "
               f"{v['training_range'][1]:.4g})" for name, v in shares.items() if v["share"] > 0]
     return f"beyond the training range: {', '.join(beyond)} of the samples: the model extrapolates there" if beyond else ""
 

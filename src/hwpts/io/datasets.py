@@ -395,14 +395,31 @@ def is_stdout(path) -> bool:
     return str(path) == "-"
 
 
+def _write_stdout(text: str) -> None:
+    """``text`` on standard output in full, or :class:`BrokenPipeError` (the reader stopped early:
+    ``| head``). Through the file descriptor, each partial write resumed: Python's buffered stream
+    dropped the rest of a large write that the pipe took only in part, without an error, and the
+    command said "wrote to standard output (400000 rows ...)" after ``| head -c 100``."""
+    import sys
+
+    stream = sys.stdout
+    try:
+        fd = stream.fileno()
+    except (AttributeError, ValueError, io.UnsupportedOperation):  # not a file (a test's capture)
+        stream.write(text)
+        stream.flush()
+        return
+    stream.flush()
+    view = memoryview(text.encode(getattr(stream, "encoding", None) or "utf-8", errors="backslashreplace"))
+    while view:
+        view = view[os.write(fd, view):]
+
+
 def write_table(path: str | os.PathLike, columns: Mapping[str, np.ndarray]) -> None:
     """Write named columns to ``.csv`` or ``.parquet`` (by extension), atomically; ``-`` writes CSV
     to standard output."""
     if is_stdout(path):
-        import sys
-
-        sys.stdout.write(csv_text(columns))
-        sys.stdout.flush()
+        _write_stdout(csv_text(columns))
         return
     p = Path(path)
     if p.suffix.lower() == ".parquet":

@@ -581,6 +581,18 @@ class PWARXSearch(BaseEstimator):
         ``n_samples`` (what each candidate is fitted on), for orders whose largest lag is ``max_lag``."""
         return int(min(len(train) for train, _ in self._splits(int(n_samples), int(max_lag))))
 
+    def n_regressor_rows(self, n_samples: int, max_lag: int = 0, model_lag: int | None = None) -> int:
+        """Regressor rows of the smallest training part of this search's cross-validation on a
+        record of ``n_samples`` (blocks sized for the largest lag ``max_lag`` of the grid), for a
+        model whose largest lag is ``model_lag`` (default ``max_lag``): each contiguous stretch of
+        the part loses its first ``model_lag`` samples as initial conditions (the rows spanning a
+        gap are dropped, as :meth:`PWARX.fit` drops them at ``breaks``)."""
+        from hwpts.identification.selection.splitters import breaks_of
+
+        lag = int(max_lag if model_lag is None else model_lag)
+        return int(min(len(train) - lag * (1 + len(breaks_of(train)))
+                       for train, _ in self._splits(int(n_samples), int(max_lag))))
+
     def _splits(self, n: int, max_lag: int):
         min_block = MIN_BLOCK + max_lag
         cv = self.cv
