@@ -707,3 +707,55 @@ def test_search_passes_over_a_model_that_reproduces_its_record_worse_than_one_ar
     assert best.simulate(u, y).score(y) >= line.simulate(u, y).score(y) - search.refit_margin
     passed = [r for r in search.cv_results_ if "its free run over the record" in (r.get("error") or "")]
     assert passed and all("threshold" == r["params"]["segmentation"] for r in passed)
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"X": None}, "inputs must be an array of numbers, got NoneType"),
+    ({"X": {"a": 1}}, "inputs must be an array of numbers, got dict"),
+    ({"X": "ragged"}, "rows of one length"),
+    ({"y": "generator"}, "output must be an array of numbers, got generator"),
+    ({"input_names": 5}, "input_names must be a sequence of 1 name"),
+    ({"input_names": "abc"}, "input_names must be a sequence of 1 name"),
+])
+def test_fit_refuses_what_is_no_array_of_numbers_in_one_line(kwargs, match):
+    """A review (2026-11-28): these ended in AttributeError ('bool' object has no attribute
+    'astype'), numpy's inhomogeneous-shape ValueError or 'int' object is not iterable; a string
+    of input names was split into its letters."""
+    rng = np.random.default_rng(0)
+    u = rng.uniform(-1, 1, (300, 1))
+    y = np.convolve(u[:, 0], [0, 1, 0.5])[:300]
+    args = {"X": u, "y": y}
+    args.update(kwargs)
+    if isinstance(args["X"], str):  # "ragged"
+        args["X"] = [[1.0], [2.0, 3.0]] + u[2:].tolist()
+    if isinstance(args["y"], str):
+        args["y"] = (v for v in y)
+    with pytest.raises((DataError, ParameterError), match=match):
+        PWARX(1, 1, 1).fit(**args)
+
+
+def test_settings_a_search_would_fail_in_every_fold_are_said_before_it():
+    """A review (2026-11-28): an unknown region model or partition column, a constant input, empty
+    arrays, (n, 1) index columns as a cv split and segmentation_params with a key that is no name failed inside the
+    folds (IdentificationError '... in the cross-validation's fold 1 of 5'), in numpy or in
+    scikit-learn; each is now the one line PWARX gives."""
+    from hwpts.identification.segmentation import make_segmenter
+
+    rng = np.random.default_rng(0)
+    u = rng.uniform(-1, 1, (300, 1))
+    y = np.convolve(u[:, 0], [0, 1, 0.5])[:300]
+    with pytest.raises(ParameterError, match="unknown region model 'bogus'"):
+        PWARXSearch(PWARX(region_models=["bogus"])).fit(u, y)
+    with pytest.raises(DataError, match="input 'u1' is constant"):
+        PWARXSearch(PWARX()).fit(np.ones((300, 1)), y)
+    with pytest.raises(DataError, match="is empty"):
+        PWARXSearch(PWARX(1, 1, 1), {"n_regions": [1, 2]}).fit(np.empty((0, 1)), np.empty(0))
+    cv = [(np.arange(200)[:, None], np.arange(200, 300)[:, None])]
+    with pytest.raises(ParameterError, match="1-D array of sample indices"):
+        PWARXSearch(PWARX(1, 1, 1), {"n_regions": [1, 2]}, cv=cv).fit(u, y)
+    with pytest.raises(ParameterError, match=r"partition_columns \['zz'\] name no regressor column"):
+        PWARXSearch(PWARX(partition_columns=["zz"], random_state=0)).fit(u, y)  # (it returned one ARX model)
+    with pytest.raises(ParameterError, match="segmentation_params must map parameter names"):
+        PWARX(1, 1, 1, segmentation_params={1: 2}).fit(u, y)
+    with pytest.raises(ParameterError, match="segmentation_params: Invalid parameter 'bogus'"):
+        PWARX(1, 1, 1, segmentation=make_segmenter("kmeans"), segmentation_params={"bogus": 1}).fit(u, y)

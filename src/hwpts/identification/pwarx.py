@@ -277,6 +277,9 @@ class PWARX(BaseEstimator):
                         "region_models": "a list of region model kinds (one per region)",
                         "partition_columns": "a column name or a non-empty list of them"}[name]
                 raise ParameterError(f"{name} must be {what} or None, got {value!r}")
+        for kind in self.region_models or ():  # (inside a model search: every candidate failed in its folds)
+            if kind not in MODEL_KINDS:
+                raise ParameterError(f"unknown region model {kind!r}; valid are {list(MODEL_KINDS)}")
         check_random_state(self.random_state)
         if segmenter:
             self._segmenter().check_params()  # the method's own settings (segmentation_params)
@@ -288,12 +291,18 @@ class PWARX(BaseEstimator):
 
         if isinstance(self.segmentation, Segmenter):
             if self.segmentation_params:
-                return clone(self.segmentation).set_params(**self.segmentation_params)
+                try:
+                    return clone(self.segmentation).set_params(**self.segmentation_params)
+                except ValueError as error:  # scikit-learn's "Invalid parameter 'x' for estimator ..."
+                    raise ParameterError(f"segmentation_params: {error}") from None
             return clone(self.segmentation)
         if self.segmentation == "auto":
             raise ParameterError("segmentation 'auto' is a model search, not a model: use "
                                  "PWARXSearch(PWARX(...)) (what `hwpts identify` does by default)")
         params = dict(self.segmentation_params or {})
+        if any(not isinstance(key, str) for key in params):  # (TypeError: keywords must be strings)
+            raise ParameterError(f"segmentation_params must map parameter names (str) to values, got keys "
+                                 f"{[key for key in params if not isinstance(key, str)]!r}")
         if self.segmentation == "hyperplane":
             params.setdefault("hyperplanes", tuple(self.hyperplanes or ()))
         elif self.hyperplanes:
@@ -799,6 +808,9 @@ def _check_signals_fit(structure, u, yy) -> None:
 def signal_names(names, output_name, n_inputs) -> tuple[tuple[str, ...], str]:
     """The inputs' and the output's names a fit gives its model: those given, else ``u1, u2, ...``
     and ``y`` (``y_out`` where an input is named ``y``); checked (:func:`_check_names`)."""
+    if names is not None and (isinstance(names, (str, bytes)) or not hasattr(names, "__iter__")):
+        # (a string was split into its letters, an int failed: 'int' object is not iterable)
+        raise ParameterError(f"input_names must be a sequence of {n_inputs} name(s), got {names!r}")
     names = tuple(names) if names is not None else default_input_names(n_inputs)
     if output_name is None:  # the output unnamed: "y", unless an input has that name
         output_name = "y" if "y" not in names else "y_out"

@@ -640,9 +640,10 @@ class PWARXSearch(BaseEstimator):
             raise ParameterError(f"PWARXSearch: cv={shown}: {error}") from None
         for train, test in splits:
             for part in (train, test):
-                if part.size == 0 or part.dtype.kind not in "iu" or part.min() < 0 or part.max() >= n:
-                    raise ParameterError(f"PWARXSearch: cv={shown}: every train and test part must be non-empty "
-                                         f"sample indices 0 .. {n - 1}")
+                if part.ndim != 1 or part.size == 0 or part.dtype.kind not in "iu" or part.min() < 0 \
+                        or part.max() >= n:
+                    raise ParameterError(f"PWARXSearch: cv={shown}: every train and test part must be a non-empty "
+                                         f"1-D array of sample indices 0 .. {n - 1}")
             if np.intersect1d(train, test).size:  # a model scored on its own training samples
                 raise ParameterError(f"PWARXSearch: cv={shown}: a train part holds samples of its test block")
             if max_lag > 0 and (test.size <= max_lag + 1 or np.any(np.diff(test) != 1)):
@@ -721,6 +722,14 @@ class PWARXSearch(BaseEstimator):
 
         check_units(units, *signal_names(names, oname, u.shape[1]))  # before the search, not after it
         self._check_orders(base, u.shape[1])
+        nb = base.input_order
+        for j, name in enumerate(names or [f"u{j + 1}" for j in range(u.shape[1])]):
+            used = nb is None or (np.atleast_1d(nb)[j] if np.size(nb) > 1 else np.atleast_1d(nb)[0]) > 0
+            if used and u.shape[0] and np.ptp(u[:, j]) == 0:  # as PWARX.fit says it, not as every fold failing
+                raise DataError(f"input {name!r} is constant ({u[0, j]:.6g}) in the training data: it carries no "
+                                f"information and makes the least squares singular; drop it or use richer data")
+        if yy.size == 0:  # (np.ptp of nothing: "zero-size array to reduction operation")
+            raise DataError(f"output {oname or 'y'!r} is empty: there is nothing to identify")
         if np.ptp(yy) == 0:
             raise DataError(f"output {oname or 'y'!r} is constant in the training data ({yy[0]:.6g}); "
                             f"there is nothing to identify")
@@ -733,6 +742,7 @@ class PWARXSearch(BaseEstimator):
         self.orders_ranking_ = None
         self.input_delays_ = None
         order_grid = self._order_grid(base, u, yy)
+        self._check_partition_columns(base, order_grid, u.shape[1], names, oname)
         max_lag = max(self._max_lag(base, o) for o in order_grid)
         try:
             splits = self._splits(n, max_lag)
@@ -789,6 +799,31 @@ class PWARXSearch(BaseEstimator):
             RegressorStructure.create(*estimator.given_orders(), n_inputs)
         except ParameterError as error:
             raise ParameterError(f"{owner}{error}") from None
+
+    def _check_partition_columns(self, base, order_grid, n_inputs, names, oname) -> None:
+        """The estimator's ``partition_columns`` name a regressor column of some candidate's
+        structure or a signal (as :meth:`PWARX.fit` checks them): a misspelt name failed every
+        candidate with regions, and the search returned a single ARX model without a word."""
+        from hwpts.identification.pwarx import signal_names
+        from hwpts.identification.regressors import RegressorStructure
+
+        wanted = base.partition_column_names()
+        if not wanted:
+            return
+        inputs, output = signal_names(names, oname, n_inputs)
+        valid = {*inputs, output}
+        for orders in order_grid:
+            na, nb, nk = self._orders_of(base, orders)
+            if isinstance(nk, str) or isinstance(nb, str) or isinstance(na, str):
+                return  # delays estimated from the data later ("auto"): checked by the fits
+            try:
+                valid.update(RegressorStructure.create(na, nb, nk, n_inputs, True, inputs, output).feature_names)
+            except ParameterError:
+                continue
+        unknown = [c for c in wanted if c not in valid]
+        if unknown:
+            raise ParameterError(f"PWARXSearch: the estimator's partition_columns {unknown} name no regressor column "
+                                 f"of any candidate; valid are {sorted(valid)}")
 
     def _check_candidate(self, base, params: dict, n_inputs: int) -> None:
         """One line naming a ``param_grid`` candidate's bad value before any fit (scikit-learn's
