@@ -493,7 +493,7 @@ def test_cv_takes_a_list_of_train_test_pairs_and_checks_them():
                          methods="threshold", output_powers=None, try_polish=False).fit(u, y)
     assert search.n_splits_ == 2 and len(search.cv_results_[0]["split_fits_percent"]) == 2
     with pytest.raises(ParameterError, match=r"cv=\[\(array\(\[ 0, 1, .*\.\.\.: every train and test part must be "
-                                             r"non-empty 1-D array of sample indices 0 .. 599"):
+                                             r"a non-empty 1-D array of sample indices 0 .. 599"):
         PWARXSearch(PWARX(1, 1, 1), cv=[(idx[:400], idx[400:] + 100)]).fit(u, y)
     for cv in ([], (pair for pair in [(idx[:400], idx[400:])])):  # min() of an empty sequence; used up by one fit
         with pytest.raises(ParameterError, match="cv as \\(train, test\\) pairs must be a non-empty list of them"):
