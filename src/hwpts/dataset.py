@@ -21,16 +21,13 @@ def dense_real(values, label: str) -> np.ndarray:
     drop the imaginary part or fail without saying which argument)."""
     if hasattr(values, "tocsr") or hasattr(values, "toarray"):
         raise DataError(f"{label} is a sparse matrix; pass a dense array ({label}.toarray())")
-    if values is None or isinstance(values, (dict, set)) or (hasattr(values, "__next__")
-                                                            and not hasattr(values, "__len__")):
-        # (a 0-d object array of it failed deep inside: 'bool' object has no attribute 'astype')
-        raise DataError(f"{label} must be an array of numbers, got {type(values).__name__}")
     try:
         arr = np.asarray(values)
     except ValueError:  # rows of different lengths: numpy's "inhomogeneous shape"
         raise DataError(f"{label} must be an array of numbers with rows of one length (a ragged list was "
                         f"given)") from None
-    if arr.dtype.kind == "O" and arr.ndim == 0:
+    if arr.dtype.kind == "O" and arr.ndim == 0:  # None, a dict, a generator: no array (a 0-d object
+        # array of it failed deep inside: 'bool' object has no attribute 'astype')
         raise DataError(f"{label} must be an array of numbers, got {type(arr.item()).__name__}")
     if np.iscomplexobj(arr):
         raise DataError(f"{label} is complex; hwpts models real signals (pass the real part or the magnitude)")

@@ -377,8 +377,8 @@ def test_the_last_hard_em_on_all_rows_never_lowers_the_own_mode_share():
 
     Z, owner, mode = np.zeros((10, 2)), np.array([0, 1]), np.array([0] * 7 + [1] * 3)
     worse, better = Fixed(1), Fixed(0)  # shares 0.3 and 0.7
-    assert _no_worse(worse, better, Z, owner, mode) == (better, 0.7)
-    assert _no_worse(better, worse, Z, owner, mode) == (better, 0.7)
+    assert _no_worse(worse, better, 0.7, Z, owner, mode) == (better, 0.7)
+    assert _no_worse(better, worse, 0.3, Z, owner, mode) == (better, 0.7)
     u, y = _voronoi_map(2000, 0)
     history = PWARX(0, 1, 0, n_regions=2, segmentation="switched", random_state=0).fit(u, y) \
         .segmentation_info_["own_mode_share"]

@@ -179,17 +179,17 @@ def _own_mode_share(part, Z, owner, mode) -> float:
     return float(np.mean(owner[part.predict(Z)] == mode))
 
 
-def _no_worse(last, screened, Z, owner, mode):
+def _no_worse(last, screened, screened_share, Z, owner, mode):
     """``(classifier, own-mode share)``: ``last``, the classifier after a last hard EM on all rows
     ``Z``, where its share is at least that of ``screened``, the classifier it started from (found
-    on the screened rows); else ``screened``. The hard EM climbs the classifier's likelihood of the
+    on the screened rows, whose share on ``Z`` is ``screened_share``); else ``screened``. The hard EM climbs the classifier's likelihood of the
     region labels, not the share: on one ``rand_vor5_d2`` set (``python -m benchmarks zoo
     --variants``) it lowered the share from 0.9917 to 0.9763 and the one-step validation fit from
     98.1 to 92.3 %. Kept only where it does not lose, the variants' medians rose on
     ``rand_vor4_na1`` (88.5 -> 90.5 %), ``rand_abcabc`` (93.5 -> 94.1), ``rand_abab_i2``
     (94.9 -> 96.5) and ``rand_aba_i4`` (95.3 -> 96.4); none fell."""
-    a, b = _own_mode_share(last, Z, owner, mode), _own_mode_share(screened, Z, owner, mode)
-    return (last, a) if a >= b else (screened, b)
+    share = _own_mode_share(last, Z, owner, mode)
+    return (last, share) if share >= screened_share else (screened, screened_share)
 
 
 class SwitchedSegmenter(Segmenter):
@@ -285,7 +285,7 @@ class SwitchedSegmenter(Segmenter):
         part = best[0]
         start = part.predict(Z)
         labels, last = _hard_em(Z, start, owner2, mode, k + 1, self.max_iter, init=part)
-        kept, share = _no_worse(last, part, Z, owner2, mode)
+        kept, share = _no_worse(last, part, best[1], Z, owner2, mode)
         return (labels if kept is last else start), kept, share
 
     def _regions(self, Z, mode, K, rng, pieces):
@@ -372,7 +372,7 @@ class SwitchedSegmenter(Segmenter):
         # all rows: each to its own mode's most probable region, then hard EM
         logp = np.where(owner[None, :] == mode[:, None], part.log_proba(Z), -np.inf)
         _, last = _hard_em(Z, np.argmax(logp, axis=1), owner, mode, owner.size, self.max_iter, init=part)
-        part, share = _no_worse(last, part, Z, owner, mode)
+        part, share = _no_worse(last, part, share, Z, owner, mode)
         history.append(round(share, 4))
         return part, owner, history
 

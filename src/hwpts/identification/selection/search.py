@@ -593,7 +593,7 @@ class PWARXSearch(BaseEstimator):
     def n_training_rows(self, n_samples: int, max_lag: int = 0) -> int:
         """Samples of the smallest training part of this search's cross-validation on a record of
         ``n_samples`` (what each candidate is fitted on), for orders whose largest lag is ``max_lag``."""
-        return int(min(len(train) for train, _ in self._splits(int(n_samples), int(max_lag))))
+        return self.n_regressor_rows(n_samples, max_lag, model_lag=0)
 
     def n_regressor_rows(self, n_samples: int, max_lag: int = 0, model_lag: int | None = None) -> int:
         """Regressor rows of the smallest training part of this search's cross-validation on a
@@ -718,21 +718,20 @@ class PWARXSearch(BaseEstimator):
         # method's own settings are the candidates', which replace the method: checked with them)
         base._check_settings(segmenter=False)
         u, yy, names, oname = base._signals(X, y, input_names, output_name)
-        from hwpts.identification.pwarx import check_units, signal_names
+        from hwpts.identification.pwarx import _check_signals_fit, check_units, signal_names
+        from hwpts.identification.regressors import RegressorStructure
 
-        check_units(units, *signal_names(names, oname, u.shape[1]))  # before the search, not after it
+        signals = signal_names(names, oname, u.shape[1])
+        check_units(units, *signals)  # before the search, not after it
         self._check_orders(base, u.shape[1])
-        nb = base.input_order
-        for j, name in enumerate(names or [f"u{j + 1}" for j in range(u.shape[1])]):
-            used = nb is None or (np.atleast_1d(nb)[j] if np.size(nb) > 1 else np.atleast_1d(nb)[0]) > 0
-            if used and u.shape[0] and np.ptp(u[:, j]) == 0:  # as PWARX.fit says it, not as every fold failing
-                raise DataError(f"input {name!r} is constant ({u[0, j]:.6g}) in the training data: it carries no "
-                                f"information and makes the least squares singular; drop it or use richer data")
         if yy.size == 0:  # (np.ptp of nothing: "zero-size array to reduction operation")
             raise DataError(f"output {oname or 'y'!r} is empty: there is nothing to identify")
         if np.ptp(yy) == 0:
             raise DataError(f"output {oname or 'y'!r} is constant in the training data ({yy[0]:.6g}); "
                             f"there is nothing to identify")
+        # the signals as PWARX.fit checks them (a constant input, values too small, an offset that
+        # leaves too few digits): said once, not as every candidate failing in every fold
+        _check_signals_fit(RegressorStructure.create(*base.given_orders(), u.shape[1], True, *signals), u, yy)
         self._names = (names, oname)
         n = yy.shape[0]
         # "auto" is decided after the ARX stage of the adaptive search; until then the free run ranks
@@ -814,8 +813,6 @@ class PWARXSearch(BaseEstimator):
         valid = {*inputs, output}
         for orders in order_grid:
             na, nb, nk = self._orders_of(base, orders)
-            if isinstance(nk, str) or isinstance(nb, str) or isinstance(na, str):
-                return  # delays estimated from the data later ("auto"): checked by the fits
             try:
                 valid.update(RegressorStructure.create(na, nb, nk, n_inputs, True, inputs, output).feature_names)
             except ParameterError:
@@ -1415,11 +1412,13 @@ class PWARXSearch(BaseEstimator):
         rest = sorted((r for r in ok if r not in near), key=lambda r: -self._score(r))
         return near + rest
 
-    def _refit(self, base, params, u, y, names, oname, splits, cv_mean):
+    def _refit(self, base, params, u, y, names, oname, splits, cv_mean, references=None):
         """``(model, None, warnings)`` of the candidate refitted on all data, or ``(None, why, [])``;
         ``warnings``: what the refit itself said about the model (:class:`RegionWarning`: regions
         dropped, with too few rows, ill-conditioned), which the chosen model passes on to the user
-        (the candidates' fits on the folds stay silent)."""
+        (the candidates' fits on the folds stay silent). ``references``: a dict of the ARX models'
+        free-run fits over the record by orders, filled as they are computed (one fit an order for
+        the candidates tried in turn)."""
         from hwpts.identification.local_models import RegionWarning
 
         model = clone(base).set_params(**params)
@@ -1450,9 +1449,13 @@ class PWARXSearch(BaseEstimator):
                 warnings.simplefilter("ignore")
                 own = model.simulate(u, y).score(y)
                 st = model.structure_
-                line = type(base)(st.na, list(st.nb), list(st.nk), n_regions=1,
-                                  segmentation="average").fit(u, y, names, oname)
-                reference = line.simulate(u, y).score(y)
+                key = (st.na, st.nb, st.nk)
+                references = {} if references is None else references
+                if key not in references:
+                    line = type(base)(st.na, list(st.nb), list(st.nk), n_regions=1,
+                                      segmentation="average").fit(u, y, names, oname)
+                    references[key] = line.simulate(u, y).score(y)
+                reference = references[key]
             if reference >= RECORD_FLOOR and not own >= reference - self.refit_margin:
                 return None, (f"refit on all data: its free run over the record reaches {own:.1f} %, more than "
                               f"{self.refit_margin} points below the {reference:.1f} % of one ARX model of its "
@@ -1460,6 +1463,7 @@ class PWARXSearch(BaseEstimator):
         return model, None, said
 
     def _choose_and_refit(self, base, table, u, y, names, oname, splits):
+        references = {}  # the ARX models' free runs over the record, by orders (_refit)
         for row in self._preference(base, table, u):
             params = dict(row["params"])
             polish = self.try_polish
@@ -1472,7 +1476,8 @@ class PWARXSearch(BaseEstimator):
                 if np.isfinite(self._score(trial)) and self._beats(trial, row):
                     params, row = trial["params"], trial
             try:
-                model, why, said = self._refit(base, params, u, y, names, oname, splits, self._score(row))
+                model, why, said = self._refit(base, params, u, y, names, oname, splits, self._score(row),
+                                               references)
             except HwptsError as error:
                 model, why, said = None, f"refit on all data failed: {error}", []
             if model is None:
