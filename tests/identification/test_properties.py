@@ -63,6 +63,30 @@ def test_noise_free_pwarx_is_recovered(seed, na, threshold):
     assert region_accuracy(m_val[ok], model.predict_regions(u_val, y_val)[ok]) >= 0.98
 
 
+
+@SETTINGS
+@given(seed=st.integers(0, 2**16), u_exp=st.integers(-13, 12), y_exp=st.integers(-13, 12),
+       method=st.sampled_from(["alternating", "clustering", "threshold", "hinging", "switched", "zscore"]))
+@example(seed=1, u_exp=-12, y_exp=-12, method="clustering")  # every partition collapsed to one region
+def test_the_regions_do_not_depend_on_the_signals_units(seed, u_exp, y_exp, method):
+    """The same record in other units (a current in A or in pA, a pressure in Pa or in bar) gives the
+    same regions: no learned partition may take signals of 1e-12 for constants (an absolute floor
+    of 1e-12 on a column's spread once made every method's partition one region)."""
+    rng = np.random.default_rng(seed)
+    structure = RegressorStructure.create(1, [1], [1], 1)
+    part = hyperplane_partition([Hyperplane([1.0], 0.0, ["u1"])], structure)
+    theta = np.array([[0.5, 1.0, 0.0], [-0.3, -1.0, 1.0]])
+    u = rng.uniform(-1, 1, (400, 1))
+    y, _ = simulate_true_pwarx(structure, part, theta, u, 0.01 * rng.standard_normal(400), np.zeros(1))
+    su, sy = 10.0 ** u_exp, 10.0 ** y_exp
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ref = PWARX(1, 1, 1, n_regions=2, segmentation=method, random_state=0).fit(u, y)
+        other = PWARX(1, 1, 1, n_regions=2, segmentation=method, random_state=0).fit(u * su, y * sy)
+    assert other.n_regions_ == ref.n_regions_
+    agree = region_accuracy(ref.predict_regions(u, y), other.predict_regions(u * su, y * sy))
+    assert agree >= 0.98, (method, agree)
+
 @SETTINGS
 @given(seed=st.integers(0, 2**16), na=st.integers(1, 3), nk=st.integers(0, 2))
 def test_predict_and_simulate_agree_for_the_true_model(seed, na, nk):

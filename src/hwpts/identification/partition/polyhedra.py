@@ -210,8 +210,9 @@ def fit_linear_partition(X: np.ndarray, labels: np.ndarray, n_regions: int, C: f
         return partition
     mean = X.mean(axis=0)
     sd = X.std(axis=0)
-    # a constant column: its rounding (a std of 5e-16 for a column of 0.1) is not a signal to scale up
-    sd[sd <= 1e-12 * np.maximum(1.0, np.abs(mean))] = 1.0
+    # a constant column: its rounding (a std of 5e-16 for a column of 0.1) is not a signal to scale up;
+    # relative to the column's own size, so that signals of 1e-12 (a current in A) still vary
+    sd[sd <= 1e-12 * np.abs(X).max(axis=0, initial=0.0)] = 1.0
     Z = (X - mean) / sd
     W = np.zeros((n_regions, nf))
     b = np.full(n_regions, -1e6)  # absent labels: a score that never wins

@@ -238,7 +238,7 @@ class HingingSegmenter(Segmenter):
         mean, sd = X[rows].mean(axis=0), X[rows].std(axis=0)
         # a column constant to rounding (an input held over these rows) takes no part: scaled by its
         # rounding-level spread, its hinge weight grew to 1e18 and a 1e-12 change moved rows
-        varies = sd > 1e-12 * np.maximum(1.0, np.abs(mean))
+        varies = sd > 1e-12 * np.abs(X[rows]).max(axis=0, initial=0.0)  # (relative: any unit)
         allowed = np.zeros(p, dtype=bool)
         allowed[list(range(p)) if columns is None else list(columns)] = True
         hinged = np.flatnonzero(varies & allowed)
