@@ -77,6 +77,10 @@ def test_breaks_drop_the_rows_that_span_them():
     (dict(methods=[3]), "methods has 3"),
     (dict(methods=[]), "methods leaves nothing to try"),
     (dict(methods=5), "methods must be a list of segmentation names"),
+    # every candidate failed (hyperplane) or made one model at every count, and the shared modes won
+    (dict(methods=["hyperplane"]), "methods has 'hyperplane', whose regions are its own rule or given hyperplanes"),
+    (dict(methods=["threshold", "zscore"]), "methods has 'zscore', whose regions .* expected methods that learn"),
+    (dict(methods=["average"]), r"methods has 'average'.* fit PWARX\(segmentation='average'\) alone"),
     (dict(max_regions=0), "max_regions must be 'auto' or an int >= 1, got 0"),
     (dict(max_regions=2.5), "max_regions must be 'auto' or an int >= 1"),
     (dict(patience=0), "patience must be an int >= 1, got 0"),

@@ -683,6 +683,43 @@ def test_a_search_told_its_methods_is_not_given_the_refinement():
     assert {r["params"]["segmentation"] for r in search.cv_results_} == {"average", "threshold"}
 
 
+def test_methods_the_user_chose_get_no_shared_modes_unasked():
+    """``methods=["clustering"]`` tries clustering alone, as ``hwpts identify --segmentation
+    clustering`` (the shared-modes stage, on by default, added the switched segmentation, which
+    won where it fitted best); ``shared_modes=True`` still asks for it. Data of two modes drawn at random at each
+    step: no partition holds them, two switched models do (the gate opens)."""
+    rng = np.random.default_rng(0)
+    u = rng.uniform(-1, 1, 800)
+    y = np.zeros(800)
+    for k in range(1, 800):
+        a, b = (0.6, 1.0) if rng.random() < 0.5 else (-0.5, -1.0)
+        y[k] = a * y[k - 1] + b * u[k - 1] + 0.01 * rng.standard_normal()
+    u = u[:, None]
+    chosen = PWARXSearch(PWARX(1, 1, 1, random_state=0), methods=["clustering"], output_powers=None).fit(u, y)
+    assert {r["params"]["segmentation"] for r in chosen.cv_results_} == {"average", "clustering"}
+    asked = PWARXSearch(PWARX(1, 1, 1, random_state=0), methods=["clustering"], output_powers=None,
+                        shared_modes=True).fit(u, y)
+    assert asked.modes_gate_["open"] and "switched" in {r["params"]["segmentation"] for r in asked.cv_results_}
+
+
+def test_a_search_whose_every_model_with_regions_failed_says_so():
+    """A segmenter that fails on every block leaves the single ARX models: the search says that no
+    candidate with regions could be fitted, with the cause (it returned one ARX model silently)."""
+    from hwpts.errors import IdentificationError
+    from hwpts.identification.segmentation import ThresholdSegmenter
+
+    class Failing(ThresholdSegmenter):
+        def segment(self, *args, **kwargs):
+            raise IdentificationError("no boundary today")
+
+    from .test_settings import two_modes
+
+    u, y = two_modes()
+    with pytest.warns(UserWarning, match=r"every candidate with regions failed \(no boundary today"):
+        search = PWARXSearch(PWARX(1, 1, 1, random_state=0), methods=[Failing()], output_powers=None).fit(u, y)
+    assert search.best_estimator_.n_regions_ == 1
+
+
 def test_a_refinement_dropped_from_the_race_is_not_raced_again(monkeypatch):
     """Once raced (the split's free run worse than none) the refinement is dropped as any method
     that trails ``patience`` counts in a row, and not brought back at the next count (it was: it

@@ -383,8 +383,11 @@ class PWARXSearch(BaseEstimator):
         map (no lagged signal in the regressor) a shuffled ``KFold`` instead, since the order of the
         rows carries nothing and contiguous blocks of data sorted along an input would only test
         extrapolation.
-    methods : sequence of str
-        Segmentation methods of the adaptive search.
+    methods : sequence of str or segmenters
+        Segmentation methods of the adaptive search: methods that learn a partition of a given
+        number of regions (not ``average``, ``zscore`` or ``hyperplane``, whose regions are their
+        own rule or the user's: refused). A candidate with regions that fails is ranked last;
+        when every one fails, a warning says why and the model is one of those without.
     orders : None, "auto" or dict
         ``None`` (default): the estimator's orders, and those it leaves ``None`` (``PWARX()``'s
         defaults) searched as ``"auto"`` searches them, except that the input delay is 1 when
@@ -441,8 +444,10 @@ class PWARXSearch(BaseEstimator):
         A progress bar on a terminal.
     shared_modes : {"auto", True, False}
         Whether the adaptive search also tries the ``switched`` segmentation (module doc, step 3):
-        ``"auto"`` (default) when the gate opens, ``True`` always, ``False`` never (nor when
-        ``"switched"`` is one of ``methods``, where it is grown as the others). ``True`` with a
+        ``"auto"`` (default) when the gate opens and ``methods`` are the default ones (methods
+        the user chose are tried alone, as ``hwpts identify --segmentation``), ``True`` always,
+        ``False`` never (nor when ``"switched"`` is one of ``methods``, where it is grown as the
+        others). ``True`` with a
         ``param_grid`` or a fixed ``n_regions``, where the stage is not run, is refused.
     scoring : {"auto", "free_run", "one_step"}
         What ranks the candidates: the mean held-out free-run fit, or the mean held-out one-step
@@ -994,6 +999,12 @@ class PWARXSearch(BaseEstimator):
                         break
             if number == 0:
                 survivors = active
+        tried = [r for r in table if r.get("stage") == "regions" and (r["params"].get("n_regions") or 1) > 1]
+        if tried and all(r["error"] for r in tried):  # (said: the model kept had no regions to choose from)
+            errors = sorted({r["error"] for r in tried})
+            warnings.warn(f"PWARXSearch: every candidate with regions failed ({errors[0]}"
+                          f"{f'; and {len(errors) - 1} other causes' if len(errors) > 1 else ''}): "
+                          f"the model is chosen among those without", UserWarning, stacklevel=3)
         table.extend(self._modes_stage(base, table, u, y, splits, bar))
         table.extend(self._powers_stage(base, table, u, y, splits, bar))
         return table
@@ -1055,11 +1066,16 @@ class PWARXSearch(BaseEstimator):
             raise ParameterError(f"PWARXSearch: methods must be a list of segmentation names, "
                                  f"got {self.methods!r}") from None
         for method in methods:
-            if isinstance(method, Segmenter):
-                continue
-            if not isinstance(method, str) or method not in SEGMENTATION_METHODS:
+            if not isinstance(method, Segmenter) and (not isinstance(method, str) or method not in SEGMENTATION_METHODS):
                 raise ParameterError(f"PWARXSearch: methods has {method!r}; valid are {sorted(SEGMENTATION_METHODS)} "
                                      f"or segmenter instances")
+            kind = method if isinstance(method, Segmenter) else SEGMENTATION_METHODS[method]
+            if not kind.uses_n_regions:  # (hyperplane: every candidate failed, and one ARX model was returned)
+                name = getattr(method, "name", method)
+                raise ParameterError(f"PWARXSearch: methods has {name!r}, whose regions are its own rule or given "
+                                     f"hyperplanes, not a number the search can choose: expected methods that learn "
+                                     f"them, e.g. {list(DEFAULT_METHODS)}; fit PWARX(segmentation={name!r}) alone, or "
+                                     f"search its orders with a param_grid")
         if not methods:
             raise ParameterError("PWARXSearch: methods leaves nothing to try")
         return methods
@@ -1218,6 +1234,8 @@ class PWARXSearch(BaseEstimator):
         the one-step fit improves (``patience``), as in the region stage."""
         if self.shared_modes is False or "switched" in self._methods() or self._fixed() is not None:
             return []  # (K modes make K or more regions: not a count the user fixed)
+        if self.shared_modes == "auto" and self._methods() != DEFAULT_METHODS:
+            return []  # methods the user chose: no other is tried unasked (as `hwpts identify --segmentation`)
         ok = [r for r in table if np.isfinite(self._score(r))]
         if not ok:
             return []
