@@ -828,6 +828,9 @@ def test_a_count_no_order_can_hold_and_an_estimators_own_partition_are_said_not_
         PWARXSearch(PWARX(1, 1, 1, segmentation="kmeans"), **fast).fit(u, y)
     with pytest.raises(ParameterError, match=r"segmentation 'hyperplane' fixes its partition"):
         PWARXSearch(PWARX(1, 1, 1, segmentation="hyperplane", hyperplanes=["1,0"]), **fast).fit(u, y)
+    # hyperplanes beside the default method: PWARX's own line, not "segmentation 'clustering' fixes its partition"
+    with pytest.raises(ParameterError, match=r"^hyperplanes were given but segmentation is 'clustering'; use"):
+        PWARXSearch(PWARX(1, 1, 1, hyperplanes=["1,0"]), **fast).fit(u, y)
     kept = PWARXSearch(PWARX(1, 1, 1, segmentation="threshold", n_regions=3, random_state=0), methods=["threshold"],
                        n_regions=3, **fast).fit(u, y)
     assert kept.best_params_["segmentation"] == "threshold" and kept.best_estimator_.n_regions_ == 3

@@ -1019,7 +1019,8 @@ class PWARXSearch(BaseEstimator):
 
         default = PWARX()
         methods = self._methods()
-        if base.hyperplanes is not None or base._segmenter().given_partition():
+        given = base._segmenter().given_partition()  # (hyperplanes with another method: PWARX's own error)
+        if base.hyperplanes is not None or given:
             raise ParameterError(
                 f"PWARXSearch: the estimator's segmentation {base.segmentation!r} fixes its partition, which the "
                 f"adaptive search would replace; to choose only its orders give param_grid (e.g. "
