@@ -32,7 +32,11 @@ def main(argv=None) -> int:
     text = readme.read_text()
     head, rest = text.split(START, 1)
     _, tail = rest.split(END, 1)
-    block = f"{START}\n```\n$ hwpts reproduce --seed {summary['seed']}\n{fit_table(summary)}\n```\n{END}"
+    # the command's last line, from the folder it wrote (as `hwpts reproduce` counts them)
+    counts = {part: len(list((results / part).iterdir())) for part in ("figures", "models", "data")}
+    wrote = (f"wrote {results}/: summary.json, report.html, {counts['figures']} figures, {counts['models']} models, "
+             f"{counts['data']} data files in {summary['timings_s']['total']:.1f} s")
+    block = f"{START}\n```\n$ hwpts reproduce --seed {summary['seed']}\n{fit_table(summary)}\n{wrote}\n```\n{END}"
     readme.write_text(head + block + tail)
     print(f"README.md: fit table and {len(FIGURES)} figures from {results}/ (seed {summary['seed']})")
     return 0

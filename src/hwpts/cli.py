@@ -11,6 +11,7 @@ import argparse
 import contextlib
 import io
 import os
+import re
 import shlex
 import signal
 import sys
@@ -239,8 +240,8 @@ def _run(argv: Sequence[str] | None) -> int:
             # source path, came before the error line of one that failed: three lines for one error)
             warnings.simplefilter("default")
             status = int(args.handler(args) or EXIT_OK)
-        for message in dict.fromkeys(_one_line(f"hwpts: warning: {w.message}") for w in caught
-                                     if not issubclass(w.category, (DeprecationWarning, PendingDeprecationWarning))):
+        for message in _warning_lines([w.message for w in caught
+                                       if not issubclass(w.category, (DeprecationWarning, PendingDeprecationWarning))]):
             print(message, file=sys.stderr)
         _SETTLED.set()  # a signal from here on arrives after the run: its status stands
     except BaseException as error:
@@ -264,6 +265,30 @@ def _run(argv: Sequence[str] | None) -> int:
             return EXIT_USAGE
         return _report(error)
     return status
+
+
+_GLYPH = re.compile(r"Glyph (\d+) .*missing from font\(s\) (.+?)\.?$")
+
+
+def _warning_lines(messages) -> list[str]:
+    """The warnings of a run that succeeded, one line each, each once; matplotlib's glyph warnings
+    (one per character a figure's font cannot draw: four lines for a file named 模型.json) in one."""
+    lines, glyphs, fonts = [], [], []
+    for message in messages:
+        match = _GLYPH.match(str(message))
+        if match:
+            glyphs.append(chr(int(match.group(1))))
+            fonts.append(match.group(2))
+            if len(glyphs) == 1:
+                lines.append(None)  # the place of the glyph line
+        else:
+            lines.append(_one_line(f"hwpts: warning: {message}"))
+    if glyphs:
+        chars = "".join(dict.fromkeys(glyphs))
+        lines[lines.index(None)] = _one_line(
+            f"hwpts: warning: the figures' font ({', '.join(dict.fromkeys(fonts))}) cannot draw {chars!r} (a name in a "
+            f"title or label): shown as boxes; with a font that has them installed (e.g. Noto Sans CJK) hwpts uses it")
+    return list(dict.fromkeys(lines))
 
 
 def _stdout_failed(error: BaseException) -> bool:

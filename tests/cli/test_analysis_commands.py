@@ -53,6 +53,33 @@ def test_validate_plot_writes_a_figure(files, capsys):
     _png_ok(out)
 
 
+def test_a_name_the_figure_font_cannot_draw_is_one_warning_line(files, tmp_path, capsys):
+    """A data file named in Chinese: matplotlib warned once per character its font lacks (four
+    'hwpts: warning: Glyph 27169 (...) missing from font(s) DejaVu Sans.' lines for 模型); one line
+    now, naming the characters, or none where a font that draws them is installed (it is used)."""
+    from matplotlib import font_manager
+
+    from hwpts.reporting.figures import FALLBACK_FONTS
+
+    named = tmp_path / "记录.csv"
+    named.write_bytes((files / "data.csv").read_bytes())
+    assert main(["validate", str(files / "good.json"), str(named), "--plot", str(tmp_path / "图.png")]) == 0
+    lines = [line for line in capsys.readouterr().err.splitlines() if line.startswith("hwpts: warning")]
+    if {f.name for f in font_manager.fontManager.ttflist} & set(FALLBACK_FONTS):
+        assert lines == []
+    else:
+        assert len(lines) == 1 and "cannot draw '记录'" in lines[0] and "Noto Sans CJK" in lines[0], lines
+    _png_ok(tmp_path / "图.png")
+
+
+def test_fallback_fonts_go_behind_the_families_in_use():
+    from hwpts.reporting.figures import fallback_families
+
+    assert fallback_families(["sans-serif"], {"DejaVu Sans"}) == ["sans-serif"]
+    assert fallback_families("serif", {"SimHei", "Noto Sans CJK JP"}) == ["serif", "Noto Sans CJK JP", "SimHei"]
+    assert fallback_families(["SimHei"], {"SimHei"}) == ["SimHei"]
+
+
 def test_validate_plot_labels_the_axis_by_the_datas_time(files, tmp_path, monkeypatch, capsys):
     """A model without a sample time validated on data with a time column: the axis is in seconds
     (it was labelled "sample" under the data's seconds); on data without one, it is the sample."""

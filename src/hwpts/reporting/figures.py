@@ -18,12 +18,32 @@ STYLES = {"average": ("tab:gray", ":"), "paper_uncompensated": ("tab:orange", "-
           "paper": ("tab:blue", "-"), "best": ("tab:red", "-.")}
 
 
+# fonts that draw what DejaVu Sans cannot (a file or signal name in Chinese, Japanese or Korean in a
+# title): put behind the families in use where one is installed (matplotlib falls back along the list)
+FALLBACK_FONTS = ("Noto Sans CJK SC", "Noto Sans CJK JP", "Noto Sans CJK KR", "Noto Sans SC", "Source Han Sans SC",
+                  "WenQuanYi Zen Hei", "WenQuanYi Micro Hei", "Droid Sans Fallback", "Microsoft YaHei", "SimHei",
+                  "Yu Gothic", "MS Gothic", "Malgun Gothic", "PingFang SC", "Hiragino Sans", "Arial Unicode MS")
+_FONTS_CHECKED: list = []
+
+
+def fallback_families(families, installed) -> list:
+    """``families`` (``font.family``) with the :data:`FALLBACK_FONTS` among ``installed`` behind them."""
+    families = [families] if isinstance(families, str) else list(families)
+    return [*families, *(f for f in FALLBACK_FONTS if f in installed and f not in families)]
+
+
 def _pyplot():
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    if not _FONTS_CHECKED:  # once a process
+        from matplotlib import font_manager
+
+        _FONTS_CHECKED.append(True)
+        installed = {font.name for font in font_manager.fontManager.ttflist}
+        matplotlib.rcParams["font.family"] = fallback_families(matplotlib.rcParams["font.family"], installed)
     return plt
 
 
