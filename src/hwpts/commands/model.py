@@ -433,7 +433,10 @@ def _fit_summary(model, data, path, out, elapsed, search=None, delays=None):
                     + (f"chosen among those with the {search.n_regions} region(s) asked for: the fewest parameters"
                        if _fixed_count(search) else "the fewest regions, then the fewest parameters,")
                     + f" win unless the best beats them by more than {search.tolerance} points and {search.n_standard_errors:g} "
-                    f"standard error(s) of the block differences)"
+                    f"standard error(s) of the block differences"
+                    + ("" if search.scoring_ == "one_step" else
+                       "; a smaller one that predicts one step ahead better than the best by as much stays")
+                    + ")"
                     + (f"; ranked by the one-step fit because no ARX model's held-out free run reached "
                        f"{FREE_RUN_FLOOR:g} % fit" if search.scoring == "auto" and search.scoring_ == "one_step" else "")),
         }
