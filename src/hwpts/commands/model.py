@@ -435,7 +435,7 @@ def _fit_summary(model, data, path, out, elapsed, search=None, delays=None):
                     + f" win unless the best beats them by more than {search.tolerance} points and {search.n_standard_errors:g} "
                     f"standard error(s) of the block differences"
                     + ("" if search.scoring_ == "one_step" else
-                       "; a smaller one that predicts one step ahead better than the best by as much stays")
+                       "; a smaller one that predicts one step ahead better than the best by more than the best's free run gains stays")
                     + ")"
                     + (f"; ranked by the one-step fit because no ARX model's held-out free run reached "
                        f"{FREE_RUN_FLOOR:g} % fit" if search.scoring == "auto" and search.scoring_ == "one_step" else "")),
