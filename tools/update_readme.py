@@ -33,7 +33,8 @@ def main(argv=None) -> int:
     head, rest = text.split(START, 1)
     _, tail = rest.split(END, 1)
     # the command's last line, from the folder it wrote (as `hwpts reproduce` counts them)
-    counts = {part: len(list((results / part).iterdir())) for part in ("figures", "models", "data")}
+    counts = {part: len(list((results / part).glob(pattern)))
+              for part, pattern in (("figures", "*.png"), ("models", "*.json"), ("data", "*.csv"))}
     wrote = (f"wrote {results}/: summary.json, report.html, {counts['figures']} figures, {counts['models']} models, "
              f"{counts['data']} data files in {summary['timings_s']['total']:.1f} s")
     block = f"{START}\n```\n$ hwpts reproduce --seed {summary['seed']}\n{fit_table(summary)}\n{wrote}\n```\n{END}"

@@ -287,7 +287,8 @@ def _warning_lines(messages) -> list[str]:
         chars = "".join(dict.fromkeys(glyphs))
         lines[lines.index(None)] = _one_line(
             f"hwpts: warning: the figures' font ({', '.join(dict.fromkeys(fonts))}) cannot draw {chars!r} (a name in a "
-            f"title or label): shown as boxes; with a font that has them installed (e.g. Noto Sans CJK) hwpts uses it")
+            f"title or label): shown as boxes; install a font that has them (for Chinese, Japanese or Korean e.g. "
+            f"Noto Sans CJK, which hwpts then uses)")
     return list(dict.fromkeys(lines))
 
 

@@ -19,7 +19,8 @@ STYLES = {"average": ("tab:gray", ":"), "paper_uncompensated": ("tab:orange", "-
 
 
 # fonts that draw what DejaVu Sans cannot (a file or signal name in Chinese, Japanese or Korean in a
-# title): put behind the families in use where one is installed (matplotlib falls back along the list)
+# title): put behind the families in use where one is installed (matplotlib falls back along the list),
+# once a process, in matplotlib's rcParams (a later rcdefaults() or style.use() takes them out again)
 FALLBACK_FONTS = ("Noto Sans CJK SC", "Noto Sans CJK JP", "Noto Sans CJK KR", "Noto Sans SC", "Source Han Sans SC",
                   "WenQuanYi Zen Hei", "WenQuanYi Micro Hei", "Droid Sans Fallback", "Microsoft YaHei", "SimHei",
                   "Yu Gothic", "MS Gothic", "Malgun Gothic", "PingFang SC", "Hiragino Sans", "Arial Unicode MS")

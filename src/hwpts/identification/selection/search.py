@@ -999,13 +999,15 @@ class PWARXSearch(BaseEstimator):
                         break
             if number == 0:
                 survivors = active
-        tried = [r for r in table if r.get("stage") == "regions" and (r["params"].get("n_regions") or 1) > 1]
-        if tried and all(r["error"] for r in tried):  # (said: the model kept had no regions to choose from)
+        table.extend(self._modes_stage(base, table, u, y, splits, bar))
+        tried = [r for r in table if r.get("stage") in ("regions", "modes") and (r["params"].get("n_regions") or 1) > 1]
+        if tried and all(r["error"] for r in tried) and fixed is None:
+            # (said: the model kept had no regions to choose from; with a count fixed the search
+            # raises that every candidate of that count failed)
             errors = sorted({r["error"] for r in tried})
             warnings.warn(f"PWARXSearch: every candidate with regions failed ({errors[0]}"
                           f"{f'; and {len(errors) - 1} other causes' if len(errors) > 1 else ''}): "
                           f"the model is chosen among those without", UserWarning, stacklevel=3)
-        table.extend(self._modes_stage(base, table, u, y, splits, bar))
         table.extend(self._powers_stage(base, table, u, y, splits, bar))
         return table
 
@@ -1235,7 +1237,7 @@ class PWARXSearch(BaseEstimator):
         the one-step fit improves (``patience``), as in the region stage."""
         if self.shared_modes is False or "switched" in self._methods() or self._fixed() is not None:
             return []  # (K modes make K or more regions: not a count the user fixed)
-        if self.shared_modes == "auto" and self._methods() != DEFAULT_METHODS:
+        if self.shared_modes == "auto" and {getattr(m, "name", m) for m in self._methods()} != set(DEFAULT_METHODS):
             return []  # methods the user chose: no other is tried unasked (as `hwpts identify --segmentation`)
         ok = [r for r in table if np.isfinite(self._score(r))]
         if not ok:
@@ -1447,6 +1449,8 @@ class PWARXSearch(BaseEstimator):
             raise IdentificationError(f"every candidate model{count} diverged in free run or failed: "
                                       + "; ".join(reasons))
         best = max(ok, key=self._score)
+        # the parameters in all, as regions x parameters a region (a switched model's modes, shared by
+        # more regions than there are modes, are counted once a region: an upper bound)
         size = {id(r): (r["n_regions_fitted"] or 1) * self._n_params(base, r["params"], u.shape[1]) for r in ok}
         near = [r for r in ok if not self._beats(best, r)
                 or (size[id(r)] < size[id(best)] and self._predicts_better(r, best))]
