@@ -441,12 +441,9 @@ class PWARX(BaseEstimator):
     def _kinds(self, s):
         if self.region_models is None:
             return ("affine",) * s
-        kinds = tuple(self.region_models)
+        kinds = tuple(self.region_models)  # (each kind checked by _check_settings)
         if len(kinds) != s:
             raise ParameterError(f"region_models has {len(kinds)} entries but the partition has {s} regions")
-        for kind in kinds:
-            if kind not in MODEL_KINDS:
-                raise ParameterError(f"unknown region model {kind!r}; valid are {list(MODEL_KINDS)}")
         return kinds
 
     # ------------------------------------------------------------------ prediction

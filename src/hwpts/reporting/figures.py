@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import io
 import itertools
 
@@ -24,7 +25,6 @@ STYLES = {"average": ("tab:gray", ":"), "paper_uncompensated": ("tab:orange", "-
 FALLBACK_FONTS = ("Noto Sans CJK SC", "Noto Sans CJK JP", "Noto Sans CJK KR", "Noto Sans SC", "Source Han Sans SC",
                   "WenQuanYi Zen Hei", "WenQuanYi Micro Hei", "Droid Sans Fallback", "Microsoft YaHei", "SimHei",
                   "Yu Gothic", "MS Gothic", "Malgun Gothic", "PingFang SC", "Hiragino Sans", "Arial Unicode MS")
-_FONTS_CHECKED: list = []
 
 
 def fallback_families(families, installed) -> list:
@@ -33,18 +33,22 @@ def fallback_families(families, installed) -> list:
     return [*families, *(f for f in FALLBACK_FONTS if f in installed and f not in families)]
 
 
+@functools.cache
+def _add_fallback_fonts() -> None:
+    import matplotlib
+    from matplotlib import font_manager
+
+    installed = {font.name for font in font_manager.fontManager.ttflist}
+    matplotlib.rcParams["font.family"] = fallback_families(matplotlib.rcParams["font.family"], installed)
+
+
 def _pyplot():
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    if not _FONTS_CHECKED:  # once a process
-        from matplotlib import font_manager
-
-        _FONTS_CHECKED.append(True)
-        installed = {font.name for font in font_manager.fontManager.ttflist}
-        matplotlib.rcParams["font.family"] = fallback_families(matplotlib.rcParams["font.family"], installed)
+    _add_fallback_fonts()
     return plt
 
 

@@ -177,6 +177,13 @@ def scores_to_partition(W: np.ndarray, b: np.ndarray, kind: str = "linear-classi
     return RegionPartition(H, g, kind=kind)
 
 
+def varying_columns(X: np.ndarray, sd: np.ndarray) -> np.ndarray:
+    """Which columns of ``X`` (standard deviations ``sd``) vary: a spread above 1e-12 of the column's
+    largest value. A constant column's rounding (a std of 5e-16 for a column of 0.1) is no signal to
+    scale up; relative to the column's own size, signals of 1e-12 (a current in A) still vary."""
+    return sd > 1e-12 * np.abs(X).max(axis=0, initial=0.0)
+
+
 def fit_linear_partition(X: np.ndarray, labels: np.ndarray, n_regions: int, C: float = 1e4,
                          max_iter: int = 500, columns=None, init=None) -> RegionPartition:
     """Multicategory linear classifier of regressors into regions, returned as polyhedra (eq. 9).
@@ -210,9 +217,7 @@ def fit_linear_partition(X: np.ndarray, labels: np.ndarray, n_regions: int, C: f
         return partition
     mean = X.mean(axis=0)
     sd = X.std(axis=0)
-    # a constant column: its rounding (a std of 5e-16 for a column of 0.1) is not a signal to scale up;
-    # relative to the column's own size, so that signals of 1e-12 (a current in A) still vary
-    sd[sd <= 1e-12 * np.abs(X).max(axis=0, initial=0.0)] = 1.0
+    sd[~varying_columns(X, sd)] = 1.0  # a constant column is not scaled up
     Z = (X - mean) / sd
     W = np.zeros((n_regions, nf))
     b = np.full(n_regions, -1e6)  # absent labels: a score that never wins

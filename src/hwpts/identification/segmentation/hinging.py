@@ -59,6 +59,7 @@ from scipy.optimize import least_squares
 
 from hwpts.errors import ParameterError
 from hwpts.identification.partition import RegionPartition
+from hwpts.identification.partition.polyhedra import varying_columns
 from hwpts.identification.segmentation.base import SegmentationResult, Segmenter
 
 __all__ = ["HingingSegmenter", "fit_hinges"]
@@ -238,7 +239,7 @@ class HingingSegmenter(Segmenter):
         mean, sd = X[rows].mean(axis=0), X[rows].std(axis=0)
         # a column constant to rounding (an input held over these rows) takes no part: scaled by its
         # rounding-level spread, its hinge weight grew to 1e18 and a 1e-12 change moved rows
-        varies = sd > 1e-12 * np.abs(X[rows]).max(axis=0, initial=0.0)  # (relative: any unit)
+        varies = varying_columns(X[rows], sd)
         allowed = np.zeros(p, dtype=bool)
         allowed[list(range(p)) if columns is None else list(columns)] = True
         hinged = np.flatnonzero(varies & allowed)

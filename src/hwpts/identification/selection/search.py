@@ -1235,9 +1235,10 @@ class PWARXSearch(BaseEstimator):
         orders, when ``shared_modes`` says so: ``True`` always, ``"auto"`` when the gate opens
         (:meth:`_modes_gate`). The number of modes grows from the gate's count while the score or
         the one-step fit improves (``patience``), as in the region stage."""
-        if self.shared_modes is False or "switched" in self._methods() or self._fixed() is not None:
+        names = {getattr(m, "name", m) for m in self._methods()}
+        if self.shared_modes is False or "switched" in names or self._fixed() is not None:
             return []  # (K modes make K or more regions: not a count the user fixed)
-        if self.shared_modes == "auto" and {getattr(m, "name", m) for m in self._methods()} != set(DEFAULT_METHODS):
+        if self.shared_modes == "auto" and names != set(DEFAULT_METHODS):
             return []  # methods the user chose: no other is tried unasked (as `hwpts identify --segmentation`)
         ok = [r for r in table if np.isfinite(self._score(r))]
         if not ok:
@@ -1398,23 +1399,23 @@ class PWARXSearch(BaseEstimator):
         for rank, i in enumerate(order, start=1):
             table[i]["rank"] = rank
 
+    def _margin(self, a, b) -> float:
+        """Points by which block fits ``a`` must beat ``b`` on the mean: ``tolerance``, or
+        ``n_standard_errors`` standard errors of their block-by-block differences if more (at most
+        :data:`SE_CAP` points; same blocks; one block: the tolerance alone)."""
+        se = float(np.std(a - b, ddof=1) / np.sqrt(a.size)) if a.size == b.size and a.size > 1 else 0.0
+        return max(self.tolerance, min(SE_CAP, self.n_standard_errors * se))
+
     def _beats(self, row, other) -> bool:
-        """Whether complete ``row`` scores above complete ``other`` by more than ``tolerance`` and
-        by more than ``n_standard_errors`` standard errors (at most :data:`SE_CAP` points) of their
-        block-by-block differences (same blocks; one block: the tolerance alone)."""
-        gain = self._score(row) - self._score(other)
+        """Whether complete ``row`` scores above complete ``other`` by more than :meth:`_margin`."""
         key = "split_one_step_fits_percent" if self.scoring_ == "one_step" else "split_fits_percent"
         a, b = np.asarray(row[key], float), np.asarray(other[key], float)
-        se = 0.0
-        if len(a) == len(b) and len(a) > 1:
-            se = float(np.std(a - b, ddof=1) / np.sqrt(len(a)))
-        return bool(gain > max(self.tolerance, min(SE_CAP, self.n_standard_errors * se)))
+        return bool(self._score(row) - self._score(other) > self._margin(a, b))
 
     def _predicts_better(self, row, other) -> bool:
         """Whether ``row`` predicts one step ahead better than ``other`` by more than the free run
         ranks ``other`` above it, where the free run ranks: its held-out one-step fit above
-        ``other``'s by more than ``tolerance`` and ``n_standard_errors`` standard errors (as
-        :meth:`_beats`), and by more points than ``other``'s mean free-run fit is above its own.
+        ``other``'s by more than :meth:`_margin` (as :meth:`_beats`), and by more points than ``other``'s mean free-run fit is above its own.
         Where the two fits disagree, the larger difference decides: a model bigger than another,
         or polished, whose free run gains a point or two on the noisy held-out blocks while it
         predicts one step worse by more, gains on the noise, not by its structure
@@ -1430,10 +1431,8 @@ class PWARXSearch(BaseEstimator):
         b = np.asarray(other["split_one_step_fits_percent"] or [], float)
         if not (a.size and b.size and np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
             return False
-        se = float(np.std(a - b, ddof=1) / np.sqrt(a.size)) if a.size == b.size and a.size > 1 else 0.0
         gain = float(a.mean() - b.mean())
-        return bool(gain > max(self.tolerance, min(SE_CAP, self.n_standard_errors * se))
-                    and gain > self._score(other) - self._score(row))
+        return bool(gain > self._margin(a, b) and gain > self._score(other) - self._score(row))
 
     def _preference(self, base, table, u):
         """Candidates in the order they are tried for the refit: those the best does not beat
